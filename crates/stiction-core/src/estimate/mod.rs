@@ -1,0 +1,442 @@
+//! Estimating stiction parameters from the command (op) and the valve position (mv): the paper's
+//! problem. `estimate` validates a request, runs the chosen method and returns a serde result that
+//! every front end prints its own way.
+
+pub mod aco;
+pub mod acor;
+pub mod exact;
+pub mod grid;
+pub mod objective;
+pub mod solver;
+
+use crate::models::{ModelError, ModelKind};
+use crate::rng::seeded;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+pub use aco::AcoSettings;
+pub use acor::AcorSettings;
+pub use exact::{ExactSettings, ExactSolution};
+pub use grid::GridSettings;
+pub use objective::Objective;
+pub use solver::TraceRow;
+
+/// Estimation methods.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// The paper's ant colony optimisation (Ant System on a grid of nodes).
+    Aco,
+    /// Ant colony optimisation for continuous domains.
+    AcoR,
+    /// The exact partition solver (Stenman only).
+    Exact,
+    /// Brute-force grid.
+    Grid,
+}
+
+impl Method {
+    pub const ALL: [Method; 4] = [Method::Aco, Method::AcoR, Method::Exact, Method::Grid];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Aco => "aco",
+            Method::AcoR => "aco-r",
+            Method::Exact => "exact",
+            Method::Grid => "grid",
+        }
+    }
+
+    /// The method used when none is named: exact for Stenman, ACO_R for two-parameter models.
+    pub fn default_for(kind: ModelKind) -> Method {
+        if kind == ModelKind::Stenman {
+            Method::Exact
+        } else {
+            Method::AcoR
+        }
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = EstimateError;
+    fn from_str(s: &str) -> Result<Self, EstimateError> {
+        let t = s.trim().to_ascii_lowercase().replace('_', "-");
+        let t = if t == "acor" { "aco-r".to_string() } else { t };
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == t)
+            .ok_or_else(|| EstimateError::UnknownMethod(s.to_string()))
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EstimateError {
+    #[error("unknown method '{0}'; the methods are aco, aco-r, exact, grid")]
+    UnknownMethod(String),
+    #[error("the exact method solves the Stenman model only; for {0} use aco-r, aco or grid")]
+    ExactNeedsStenman(ModelKind),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error("bounds for {name} are [{lo}, {hi}]: {why}")]
+    Bounds {
+        name: String,
+        lo: f64,
+        hi: f64,
+        why: &'static str,
+    },
+    #[error("{0}")]
+    Settings(String),
+    #[error("{0}")]
+    Data(String),
+}
+
+/// What to estimate and how.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Request {
+    pub model: ModelKind,
+    pub method: Method,
+    /// Search range per parameter, in the model's parameter order; `None` uses the model's defaults.
+    pub bounds: Option<Vec<(f64, f64)>>,
+    pub seed: u64,
+    pub aco: AcoSettings,
+    pub acor: AcorSettings,
+    pub grid: GridSettings,
+    pub exact: ExactSettings,
+    /// Keep the per-iteration trace (population methods).
+    pub trace: bool,
+    /// Stenman with a heuristic method: also run the exact solver and say whether the answer is
+    /// in the proven optimal set.
+    pub certify: bool,
+}
+
+impl Request {
+    pub fn new(model: ModelKind, method: Method) -> Self {
+        Self {
+            model,
+            method,
+            bounds: None,
+            seed: 1,
+            aco: AcoSettings::default(),
+            acor: AcorSettings::default(),
+            grid: GridSettings::default(),
+            exact: ExactSettings::default(),
+            trace: false,
+            certify: true,
+        }
+    }
+
+    /// The search range in use, checked.
+    pub fn resolved_bounds(&self) -> Result<Vec<(f64, f64)>, EstimateError> {
+        let specs = self.model.params();
+        let bounds: Vec<(f64, f64)> = match &self.bounds {
+            Some(b) => b.clone(),
+            None => specs.iter().map(|p| p.search).collect(),
+        };
+        if bounds.len() != specs.len() {
+            return Err(EstimateError::Settings(format!(
+                "model {} has {} parameters but {} bounds were given",
+                self.model,
+                specs.len(),
+                bounds.len()
+            )));
+        }
+        for (spec, &(lo, hi)) in specs.iter().zip(&bounds) {
+            let err = |why| EstimateError::Bounds {
+                name: spec.name.to_string(),
+                lo,
+                hi,
+                why,
+            };
+            if !lo.is_finite() || !hi.is_finite() {
+                return Err(err("both ends must be finite numbers"));
+            }
+            if lo < spec.min {
+                return Err(err("the lower end must not be negative"));
+            }
+            if lo >= hi {
+                return Err(err("the lower end must be below the upper end (reversed or empty)"));
+            }
+        }
+        Ok(bounds)
+    }
+
+    fn check_settings(&self) -> Result<(), EstimateError> {
+        let bad = |m: &str| Err(EstimateError::Settings(m.to_string()));
+        match self.method {
+            Method::Aco => {
+                let s = &self.aco;
+                if s.ants == 0 || s.iterations == 0 {
+                    return bad("--ants and --iterations must be at least 1");
+                }
+                if !(s.rho > 0.0 && s.rho < 1.0) {
+                    return bad("--rho (evaporation) must be between 0 and 1, exclusive");
+                }
+                if !(s.q > 0.0 && s.q.is_finite()) || !(s.elitist >= 0.0 && s.elitist.is_finite())
+                {
+                    return bad("--q must be > 0 and --elitist >= 0");
+                }
+                if !(s.resolution > 0.0 && s.resolution.is_finite()) {
+                    return bad("--resolution must be > 0");
+                }
+                if !(s.tau0 > 0.0 && s.tau0.is_finite()) || !(s.epsilon > 0.0) {
+                    return bad("--tau0 and --epsilon must be > 0");
+                }
+            }
+            Method::AcoR => {
+                let s = &self.acor;
+                if s.ants == 0 || s.iterations == 0 || s.archive < 2 {
+                    return bad("--ants and --iterations must be at least 1, --archive at least 2");
+                }
+                if !(s.q > 0.0) || !(s.xi > 0.0) {
+                    return bad("--q and --xi must be > 0");
+                }
+            }
+            Method::Grid => {
+                if self.grid.points < 2 {
+                    return bad("--points must be at least 2");
+                }
+            }
+            Method::Exact => {
+                if self.model != ModelKind::Stenman {
+                    return Err(EstimateError::ExactNeedsStenman(self.model));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The result of an estimation, shared by every front end.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Estimate {
+    pub model: ModelKind,
+    pub method: Method,
+    /// Point estimate per parameter.
+    pub params: BTreeMap<String, f64>,
+    /// Per parameter, the set of equally optimal values `[lo, hi]`, where the method can know it
+    /// (exact: proven; grid: the hull of the grid points that reach the minimum). Empty otherwise.
+    pub interval: BTreeMap<String, [f64; 2]>,
+    /// How `interval` was obtained: "exact", "grid" or "none".
+    pub interval_kind: String,
+    /// Exact method: the optimal set as disjoint half-open pieces [lo, hi) when it is not one piece.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pieces: Option<Vec<[f64; 2]>>,
+    /// Sum of squared errors between measured and modelled valve position.
+    pub sse: f64,
+    /// Root mean square error, same units as mv.
+    pub rmse: f64,
+    /// Fit quality 1 - SSE / sum (mv - mean)^2.
+    pub r2: f64,
+    pub evaluations: u64,
+    /// Iterations run (population methods), cells created (exact), 1 (grid).
+    pub iterations: u64,
+    /// Time spent estimating, excluding reading the data.
+    pub seconds: f64,
+    pub samples: usize,
+    /// Search range per parameter.
+    pub bounds: BTreeMap<String, [f64; 2]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// Stenman with a non-exact method: the proven optimal set, and whether the estimate is in it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub certificate: Option<Certificate>,
+    pub warnings: Vec<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub trace: Vec<TraceRow>,
+}
+
+/// A check of a heuristic's answer against the exact optimum (Stenman only).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Certificate {
+    pub optimal_interval: [f64; 2],
+    pub optimal_sse: f64,
+    pub estimate_is_optimal: bool,
+}
+
+/// Check the data an estimation needs: equal lengths, finite values, enough samples, a moving command.
+pub fn check_data(op: &[f64], mv: &[f64]) -> Result<(), EstimateError> {
+    if op.len() != mv.len() {
+        return Err(EstimateError::Data(format!(
+            "op has {} samples but mv has {}",
+            op.len(),
+            mv.len()
+        )));
+    }
+    if op.len() < MIN_SAMPLES {
+        return Err(EstimateError::Data(format!(
+            "only {} samples; at least {MIN_SAMPLES} are needed",
+            op.len()
+        )));
+    }
+    for (name, s) in [("op", op), ("mv", mv)] {
+        if let Some(i) = s.iter().position(|v| !v.is_finite()) {
+            return Err(EstimateError::Data(format!(
+                "{name} sample {i} is {}; every value must be a finite number",
+                s[i]
+            )));
+        }
+    }
+    let (lo, hi) = op
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if hi - lo <= 0.0 {
+        return Err(EstimateError::Data(format!(
+            "the command op is constant ({lo}); a valve that is never moved shows no stiction"
+        )));
+    }
+    Ok(())
+}
+
+/// Fewest samples an estimation accepts.
+pub const MIN_SAMPLES: usize = 10;
+
+/// Run an estimation.
+pub fn estimate(op: &[f64], mv: &[f64], req: &Request) -> Result<Estimate, EstimateError> {
+    check_data(op, mv)?;
+    req.check_settings()?;
+    let bounds = req.resolved_bounds()?;
+    let names = req.model.param_names();
+    let started = Instant::now();
+    let objective = Objective::new(req.model, op, mv);
+
+    let mut interval = BTreeMap::new();
+    let mut interval_kind = "none";
+    let mut pieces = None;
+    let mut seed = None;
+    let mut trace = Vec::new();
+    let (best, sse, evaluations, iterations) = match req.method {
+        Method::Exact => {
+            let (lo, hi) = bounds[0];
+            let sol = exact::solve_stenman(op, mv, lo, hi, &req.exact);
+            let (a, b) = sol.hull();
+            interval.insert(names[0].to_string(), [a, b]);
+            interval_kind = "exact";
+            if sol.pieces.len() > 1 {
+                pieces = Some(sol.pieces.iter().map(|&(a, b)| [a, b]).collect());
+            }
+            (
+                vec![sol.point()],
+                sol.sse,
+                sol.bound_evaluations,
+                sol.cells_created,
+            )
+        }
+        Method::Grid => {
+            let g = grid::search(&objective, &bounds, &req.grid);
+            for (p, name) in names.iter().enumerate() {
+                interval.insert(name.to_string(), [g.minimisers_hull[p].0, g.minimisers_hull[p].1]);
+            }
+            interval_kind = "grid";
+            (g.best, g.sse, g.evaluations, 1)
+        }
+        Method::Aco | Method::AcoR => {
+            seed = Some(req.seed);
+            let mut rng = seeded(req.seed);
+            let mut ev = solver::Evaluator::new(objective);
+            let iters = if req.method == Method::Aco {
+                let mut s = aco::PaperAco::new(req.aco.clone(), req.model, &bounds);
+                trace = solver::run(&mut s, &mut ev, &mut rng, req.aco.iterations, req.trace);
+                req.aco.iterations
+            } else {
+                let mut s = acor::Acor::new(req.acor.clone(), req.model, &bounds);
+                trace = solver::run(&mut s, &mut ev, &mut rng, req.acor.iterations, req.trace);
+                req.acor.iterations
+            };
+            (
+                ev.best().to_vec(),
+                ev.best_cost(),
+                ev.evaluations(),
+                iters as u64,
+            )
+        }
+    };
+
+    let certificate = if req.certify && req.model == ModelKind::Stenman && req.method != Method::Exact {
+        let (lo, hi) = bounds[0];
+        let sol = exact::solve_stenman(op, mv, lo, hi, &req.exact);
+        Some(Certificate {
+            optimal_interval: [sol.hull().0, sol.hull().1],
+            optimal_sse: sol.sse,
+            estimate_is_optimal: sol.contains(best[0]),
+        })
+    } else {
+        None
+    };
+    let seconds = started.elapsed().as_secs_f64();
+
+    let n = mv.len() as f64;
+    let mean = mv.iter().sum::<f64>() / n;
+    let sst: f64 = mv.iter().map(|v| (v - mean) * (v - mean)).sum();
+    let mut warnings = Vec::new();
+    if req.method == Method::Exact {
+        let [a, b] = interval[names[0]];
+        let mid = 0.5 * (a + b);
+        if mid > 0.0 && (b - a) > 0.2 * mid {
+            warnings.push(format!(
+                "the optimal set [{a:.4}, {b:.4}] is wide relative to d: the command does not \
+                 excite the valve enough to pin d down"
+            ));
+        }
+    }
+    if let Some(c) = &certificate {
+        if !c.estimate_is_optimal {
+            warnings.push(format!(
+                "the estimate is not in the proven optimal set [{:.4}, {:.4}] (SSE {:.6} vs {:.6})",
+                c.optimal_interval[0], c.optimal_interval[1], sse, c.optimal_sse
+            ));
+        }
+    }
+    let edge_tol = |lo: f64, hi: f64| match req.method {
+        Method::Aco => 0.5 * req.aco.resolution,
+        _ => 1e-9 * (hi - lo),
+    };
+    for (p, &(lo, hi)) in bounds.iter().enumerate() {
+        let v = best[p];
+        let at_lower = lo > 0.0 && v - lo <= edge_tol(lo, hi);
+        let at_upper = hi - v <= edge_tol(lo, hi);
+        if at_lower || at_upper {
+            warnings.push(format!(
+                "{} = {v} is at the edge of its search range [{lo}, {hi}]: widen the bounds",
+                names[p]
+            ));
+        }
+    }
+
+    Ok(Estimate {
+        model: req.model,
+        method: req.method,
+        params: names
+            .iter()
+            .zip(&best)
+            .map(|(n, &v)| (n.to_string(), v))
+            .collect(),
+        interval,
+        interval_kind: interval_kind.to_string(),
+        pieces,
+        sse,
+        rmse: (sse / n).sqrt(),
+        r2: if sst > 0.0 { 1.0 - sse / sst } else { f64::NAN },
+        evaluations,
+        iterations,
+        seconds,
+        samples: op.len(),
+        bounds: names
+            .iter()
+            .zip(&bounds)
+            .map(|(n, &(lo, hi))| (n.to_string(), [lo, hi]))
+            .collect(),
+        seed,
+        certificate,
+        warnings,
+        trace,
+    })
+}

@@ -1,0 +1,13 @@
+//! `stiction-core`: stiction models, loop simulation and estimators for control valves.
+//!
+//! Pure numerics: functions take slices and return serde-serialisable results; nothing here reads
+//! files, prints or plots. The command-line tool and every other front end share these results.
+
+pub mod estimate;
+pub mod models;
+pub mod reproduce;
+pub mod rng;
+pub mod sim;
+
+pub use estimate::{estimate, Estimate, Method, Request};
+pub use models::{Model, ModelKind, StictionModel};
