@@ -1,1 +1,55 @@
-fn main(){}
+//! `stiction`: find and measure stiction in control valves. Thin glue over `stiction-core`:
+//! flags are parsed here, turned into validated core requests, and results printed by a human or a
+//! JSON printer.
+
+mod cmd_estimate;
+mod cmd_reproduce;
+mod cmd_simulate;
+mod data;
+mod plot;
+mod spec;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "stiction",
+    version,
+    about = "Find and measure stiction (static friction) in control valves",
+    long_about = "Find and measure stiction (static friction) in control valves: simulate sticky \
+valves open or closed loop, estimate the stiction band from command and valve position with the \
+paper's ant colony optimisation, ACO_R, a grid or an exact solver, and reproduce the paper."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate a sticky valve open loop (a command signal) or in a PI control loop; writes t,sp,op,mv,pv.
+    Simulate(cmd_simulate::Args),
+    /// Estimate stiction-model parameters from the command (op) and the valve position (mv).
+    Estimate(cmd_estimate::Args),
+    /// Reproduce published results (`stiction reproduce paper`).
+    Reproduce(cmd_reproduce::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Simulate(a) => cmd_simulate::run(a),
+        Command::Estimate(a) => cmd_estimate::run(a),
+        Command::Reproduce(a) => cmd_reproduce::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // one sentence: the context chain joined, outermost first
+            let msg: Vec<String> = e.chain().map(|c| c.to_string()).collect();
+            eprintln!("error: {}", msg.join(": "));
+            ExitCode::from(2)
+        }
+    }
+}

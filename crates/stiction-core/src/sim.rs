@@ -175,7 +175,7 @@ impl Signal {
 }
 
 /// A simulated loop, one value per sample: time, setpoint, controller output, valve position,
-/// process variable. Open-loop runs have no setpoint and no process: `sp` is empty, `pv` equals `mv`.
+/// process variable. Open-loop runs have no setpoint and no process: `sp` and `pv` are empty.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct LoopData {
     pub t: Vec<f64>,
@@ -185,8 +185,9 @@ pub struct LoopData {
     pub pv: Vec<f64>,
 }
 
-/// Drive a valve open loop with a command signal; `noise` is the standard deviation of Gaussian
-/// measurement noise added to the valve position (`pv` = measured `mv`).
+/// Drive a valve open loop with a command signal. `mv` is the valve position as measured: the
+/// model's output plus Gaussian noise of standard deviation `noise` (seeded). An open loop has no
+/// setpoint and no process: `sp` and `pv` are empty.
 pub fn simulate_open_loop(
     model: &Model,
     command: &Signal,
@@ -199,24 +200,19 @@ pub fn simulate_open_loop(
     require(ts > 0.0, "the sampling time ts", "> 0 seconds", ts)?;
     require(noise >= 0.0, "noise", ">= 0", noise)?;
     let op = command.generate(ts, samples);
-    let mv = model.simulate(&op);
-    let mut rng = seeded(seed);
-    let pv = mv
-        .iter()
-        .map(|&x| {
-            if noise > 0.0 {
-                x + noise * gaussian(&mut rng)
-            } else {
-                x
-            }
-        })
-        .collect();
+    let mut mv = model.simulate(&op);
+    if noise > 0.0 {
+        let mut rng = seeded(seed);
+        for x in &mut mv {
+            *x += noise * gaussian(&mut rng);
+        }
+    }
     Ok(LoopData {
         t: (0..samples).map(|k| k as f64 * ts).collect(),
         sp: Vec::new(),
         op,
         mv,
-        pv,
+        pv: Vec::new(),
     })
 }
 

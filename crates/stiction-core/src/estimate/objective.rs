@@ -109,14 +109,13 @@ fn batch_sse<M: FromValues>(op: &[f64], mv: &[f64], dim: usize, cands: &[f64], o
         head.chunks_mut(LANES).enumerate().for_each(group);
     }
     // the remainder in narrower groups, so a batch of two costs a pass of two, not of eight
-    let mut i = full;
-    while count - i >= 2 {
-        let sums = sse_lanes(&[model(i), model(i + 1)], op, mv);
-        out[i..i + 2].copy_from_slice(&sums);
-        i += 2;
-    }
-    if i < count {
-        out[i] = sse_lanes(&[model(i)], op, mv)[0];
+    for (k, pair) in tail.chunks_mut(2).enumerate() {
+        let i = full + 2 * k;
+        if pair.len() == 2 {
+            pair.copy_from_slice(&sse_lanes(&[model(i), model(i + 1)], op, mv));
+        } else {
+            pair[0] = sse_lanes(&[model(i)], op, mv)[0];
+        }
     }
 }
 

@@ -1,0 +1,237 @@
+use crate::{cmd_simulate::write_atomic, data, spec};
+use anyhow::{bail, Context, Result};
+use std::path::PathBuf;
+use stiction_core::estimate::{self, Estimate, Method, Request};
+use stiction_core::models::ModelKind;
+
+#[derive(clap::Args)]
+#[command(after_help = "Examples:
+  stiction estimate open.csv --model stenman --method exact
+  stiction estimate open.csv --op op --mv mv --model stenman --method aco --seed 3 --json
+  stiction estimate kano.csv --model kano --method aco-r --seed 1 --trace trace.csv")]
+pub struct Args {
+    /// CSV file with a header line (comma, semicolon or tab separated)
+    file: PathBuf,
+    /// Column of the controller output (the valve's command)
+    #[arg(long, default_value = "op")]
+    op: String,
+    /// Column of the measured valve position
+    #[arg(long, default_value = "mv")]
+    mv: String,
+    /// Column of time [default: the first of t, time, timestamp, if any]
+    #[arg(long)]
+    time: Option<String>,
+    /// Stiction model: stenman, he, kano, choudhury
+    #[arg(long, default_value = "stenman")]
+    model: String,
+    /// aco (the paper's), aco-r, exact (stenman only), grid [default: exact for stenman, else aco-r]
+    #[arg(long)]
+    method: Option<String>,
+    /// Seed of the random methods
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Print one JSON object instead of text
+    #[arg(long)]
+    json: bool,
+    /// Write the best parameters and fit error per iteration to this CSV (aco, aco-r)
+    #[arg(long)]
+    trace: Option<PathBuf>,
+    /// Lower end of every parameter's search range
+    #[arg(long)]
+    lo: Option<f64>,
+    /// Upper end of every parameter's search range
+    #[arg(long)]
+    hi: Option<f64>,
+    /// One parameter's search range, NAME=LO:HI (repeatable; overrides --lo/--hi)
+    #[arg(long = "bounds", value_name = "NAME=LO:HI")]
+    bounds: Vec<String>,
+    /// aco, aco-r: ants per iteration [default: 20]
+    #[arg(long)]
+    ants: Option<usize>,
+    /// aco, aco-r: iterations [default: 100]
+    #[arg(long)]
+    iterations: Option<usize>,
+    /// aco: evaporation rate rho
+    #[arg(long, default_value_t = 0.2)]
+    rho: f64,
+    /// aco: pheromone quantity Q
+    #[arg(long, default_value_t = 100.0)]
+    q: f64,
+    /// aco: encouragement coefficient D of the best-so-far deposit
+    #[arg(long, default_value_t = 100.0)]
+    elitist: f64,
+    /// aco: spacing of the parameter grid's nodes
+    #[arg(long, default_value_t = 0.01)]
+    resolution: f64,
+    /// aco: initial pheromone per node
+    #[arg(long, default_value_t = 1e4)]
+    tau0: f64,
+    /// aco: guard added to the fit error before dividing Q by it
+    #[arg(long, default_value_t = 1e-9)]
+    epsilon: f64,
+    /// aco: most nodes the iteration's best ant walks in its local search (0: plain Ant System)
+    #[arg(long, default_value_t = 10)]
+    local_search: usize,
+    /// aco-r: archive size k
+    #[arg(long, default_value_t = 50)]
+    archive: usize,
+    /// aco-r: locality q of the rank weights
+    #[arg(long, default_value_t = 0.1)]
+    locality: f64,
+    /// aco-r: spread xi of the sampling kernels
+    #[arg(long, default_value_t = 0.85)]
+    xi: f64,
+    /// grid: points per parameter
+    #[arg(long, default_value_t = 1000)]
+    points: usize,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let kind = spec::model_kind(&a.model)?;
+    let method = match &a.method {
+        Some(m) => m.parse::<Method>().map_err(|e| anyhow::anyhow!("--method: {e}"))?,
+        None => Method::default_for(kind),
+    };
+    let mut req = Request::new(kind, method);
+    req.seed = a.seed;
+    req.trace = a.trace.is_some();
+    req.bounds = bounds(kind, &a)?;
+    req.aco.ants = a.ants.unwrap_or(req.aco.ants);
+    req.aco.iterations = a.iterations.unwrap_or(req.aco.iterations);
+    req.aco.rho = a.rho;
+    req.aco.q = a.q;
+    req.aco.elitist = a.elitist;
+    req.aco.resolution = a.resolution;
+    req.aco.tau0 = a.tau0;
+    req.aco.epsilon = a.epsilon;
+    req.aco.local_search = a.local_search;
+    req.acor.ants = a.ants.unwrap_or(req.acor.ants);
+    req.acor.iterations = a.iterations.unwrap_or(req.acor.iterations);
+    req.acor.archive = a.archive;
+    req.acor.q = a.locality;
+    req.acor.xi = a.xi;
+    req.grid.points = a.points;
+    if a.trace.is_some() && !matches!(method, Method::Aco | Method::AcoR) {
+        bail!("--trace: the {method} method has no iterations to trace; use --method aco or aco-r");
+    }
+    // settings and bounds are checked before the file is read, so a typo fails fast
+    req.resolved_bounds().map_err(|e| anyhow::anyhow!("{e}"))?;
+
+    let (op, mv) = data::read_pair(
+        &a.file,
+        (&a.op, "--op", "controller output op"),
+        (&a.mv, "--mv", "valve position mv"),
+        estimate::MIN_SAMPLES,
+    )?;
+    if let Some(name) = &a.time {
+        let table = data::Table::read(&a.file)?;
+        data::time_column(&table, Some(name))?;
+    }
+    let est = estimate::estimate(&op, &mv, &req)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.file.display()))?;
+    if let Some(path) = &a.trace {
+        write_trace(path, kind, &est)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&est)?);
+    } else {
+        print_human(&a.file.display().to_string(), &est);
+    }
+    Ok(())
+}
+
+fn bounds(kind: ModelKind, a: &Args) -> Result<Option<Vec<(f64, f64)>>> {
+    if a.lo.is_none() && a.hi.is_none() && a.bounds.is_empty() {
+        return Ok(None);
+    }
+    let mut b: Vec<(f64, f64)> = kind
+        .params()
+        .iter()
+        .map(|p| (a.lo.unwrap_or(p.search.0), a.hi.unwrap_or(p.search.1)))
+        .collect();
+    for text in &a.bounds {
+        let parsed = text.split_once('=').and_then(|(n, r)| {
+            let (lo, hi) = r.split_once(':')?;
+            Some((n.trim(), lo.trim().parse::<f64>().ok()?, hi.trim().parse::<f64>().ok()?))
+        });
+        let (name, lo, hi) = parsed.with_context(|| {
+            format!("--bounds {text}: write NAME=LO:HI, e.g. --bounds {}=0.01:10", kind.param_names()[0])
+        })?;
+        let i = kind.param_index(name).map_err(|e| anyhow::anyhow!("--bounds: {e}"))?;
+        b[i] = (lo, hi);
+    }
+    Ok(Some(b))
+}
+
+fn write_trace(path: &std::path::Path, kind: ModelKind, est: &Estimate) -> Result<()> {
+    let names = kind.param_names();
+    let mut text = String::from("iteration");
+    for n in &names {
+        text.push_str(&format!(",best_{n}"));
+    }
+    text.push_str(",best_sse");
+    for n in &names {
+        text.push_str(&format!(",iteration_best_{n}"));
+    }
+    text.push_str(",iteration_best_sse,evaluations\n");
+    for r in &est.trace {
+        text.push_str(&r.iteration.to_string());
+        for v in &r.best {
+            text.push_str(&format!(",{v}"));
+        }
+        text.push_str(&format!(",{}", r.best_sse));
+        for v in &r.iteration_best {
+            text.push_str(&format!(",{v}"));
+        }
+        text.push_str(&format!(",{},{}\n", r.iteration_best_sse, r.evaluations));
+    }
+    write_atomic(path, text.as_bytes())
+}
+
+fn print_human(file: &str, e: &Estimate) {
+    let seed = e.seed.map(|s| format!(", seed {s}")).unwrap_or_default();
+    println!(
+        "{file}: {} model, method {}{seed}, {} samples",
+        e.model, e.method, e.samples
+    );
+    for spec in e.model.params() {
+        let v = e.params[spec.name];
+        print!("  {} = {v:.4} {} ({})", spec.name, spec.unit, spec.description);
+        if let Some([lo, hi]) = e.interval.get(spec.name) {
+            let what = if e.interval_kind == "exact" {
+                "proven optimal set"
+            } else {
+                "grid points at the minimum"
+            };
+            print!("; {what} [{lo:.4}, {hi:.4}]");
+        }
+        println!();
+    }
+    if let Some(pieces) = &e.pieces {
+        let p: Vec<String> = pieces.iter().map(|[a, b]| format!("[{a:.4}, {b:.4})")).collect();
+        println!("  the optimal set is not one piece: {}", p.join(" U "));
+    }
+    if let Some(c) = &e.certificate {
+        println!(
+            "  check against the exact solver: optimal d in [{:.4}, {:.4}], SSE {:.6}; the estimate {} optimal",
+            c.optimal_interval[0],
+            c.optimal_interval[1],
+            c.optimal_sse,
+            if c.estimate_is_optimal { "is" } else { "is NOT" }
+        );
+    }
+    println!(
+        "  fit: SSE {:.6}, RMSE {:.6}, R² {:.4}",
+        e.sse, e.rmse, e.r2
+    );
+    println!(
+        "  {} evaluations, {} {}, {:.2} ms",
+        e.evaluations,
+        e.iterations,
+        if e.method == Method::Exact { "cells" } else { "iterations" },
+        e.seconds * 1e3
+    );
+    for w in &e.warnings {
+        println!("  warning: {w}");
+    }
+}

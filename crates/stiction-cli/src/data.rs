@@ -1,0 +1,182 @@
+//! Reading loop data from CSV: delimiter sniffing, case-insensitive column lookup, and one clear
+//! sentence for every way a file can be wrong (naming the file, the column and the line).
+
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+
+/// A CSV file read as text: header names and rows of cells.
+pub struct Table {
+    pub path: PathBuf,
+    pub headers: Vec<String>,
+    /// Data rows; each row as long as the header (missing trailing cells are empty).
+    rows: Vec<Vec<String>>,
+    /// File line number of each row (the header is line 1).
+    lines: Vec<u64>,
+}
+
+impl Table {
+    pub fn read(path: &Path) -> Result<Table> {
+        let text = match std::fs::read(path) {
+            Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                bail!("{}: no such file; check the path", path.display())
+            }
+            Err(e) => bail!("{}: cannot be read: {e}", path.display()),
+        };
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let first_line = text.lines().next().unwrap_or("");
+        if first_line.trim().is_empty() {
+            bail!(
+                "{}: the file is empty or its first line is blank; it needs a header line naming the columns (e.g. t,op,mv)",
+                path.display()
+            );
+        }
+        let delimiter = sniff_delimiter(first_line);
+        let mut reader = csv::ReaderBuilder::new()
+            .delimiter(delimiter)
+            .flexible(true)
+            .has_headers(true)
+            .from_reader(text.as_bytes());
+        let headers: Vec<String> = reader
+            .headers()
+            .with_context(|| format!("{}: the header line cannot be read", path.display()))?
+            .iter()
+            .map(|h| h.trim().to_string())
+            .collect();
+        let mut rows = Vec::new();
+        let mut lines = Vec::new();
+        for record in reader.records() {
+            let record = record
+                .with_context(|| format!("{}: not a readable CSV file", path.display()))?;
+            let line = record.position().map(|p| p.line()).unwrap_or(0);
+            if record.iter().all(|c| c.trim().is_empty()) {
+                continue; // blank line
+            }
+            let mut row: Vec<String> = record.iter().map(|c| c.trim().to_string()).collect();
+            if row.len() > headers.len() {
+                bail!(
+                    "{}: line {line} has {} cells but the header names {} columns; remove the extra cells or name the column",
+                    path.display(),
+                    row.len(),
+                    headers.len()
+                );
+            }
+            row.resize(headers.len(), String::new());
+            rows.push(row);
+            lines.push(line);
+        }
+        Ok(Table {
+            path: path.to_path_buf(),
+            headers,
+            rows,
+            lines,
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Index of a column by name, case-insensitive.
+    pub fn find(&self, name: &str) -> Option<usize> {
+        self.headers
+            .iter()
+            .position(|h| h.eq_ignore_ascii_case(name.trim()))
+    }
+
+    /// The column `name`, or an error naming the flag that chooses it.
+    pub fn require(&self, name: &str, flag: &str, role: &str) -> Result<usize> {
+        self.find(name).with_context(|| {
+            format!(
+                "{}: no column '{name}' for the {role}; the columns are {}. Name the right one with {flag} COLUMN",
+                self.path.display(),
+                self.headers.join(", ")
+            )
+        })
+    }
+
+    /// Parse a column as finite numbers.
+    pub fn numbers(&self, col: usize) -> Result<Vec<f64>> {
+        let name = &self.headers[col];
+        let file = self.path.display();
+        let mut out = Vec::with_capacity(self.rows.len());
+        for (i, row) in self.rows.iter().enumerate() {
+            let cell = &row[col];
+            let line = self.lines[i];
+            if cell.is_empty() {
+                let rest_empty = self.rows[i..].iter().all(|r| r[col].is_empty());
+                if rest_empty {
+                    bail!(
+                        "{file}: column '{name}' ends at line {line} with {} values while the file has {} rows; \
+                         columns of different lengths cannot be paired sample by sample: trim the file to the rows where every column has a value",
+                        out.len(),
+                        self.rows.len()
+                    );
+                }
+                bail!("{file}: line {line}, column '{name}' is empty; fill in the value or remove the row");
+            }
+            let v: f64 = cell.parse().map_err(|_| {
+                anyhow::anyhow!(
+                    "{file}: line {line}, column '{name}': '{cell}' is not a number; use plain decimal numbers such as 12.5"
+                )
+            })?;
+            if !v.is_finite() {
+                bail!(
+                    "{file}: line {line}, column '{name}' is {cell}; every value must be a finite number: remove or fill the row"
+                );
+            }
+            out.push(v);
+        }
+        Ok(out)
+    }
+}
+
+/// The delimiter the header line uses most: comma, semicolon or tab.
+fn sniff_delimiter(header: &str) -> u8 {
+    [b',', b';', b'\t']
+        .into_iter()
+        .max_by_key(|&d| header.bytes().filter(|&b| b == d).count())
+        .unwrap_or(b',')
+}
+
+/// The time column: `--time COL` if given, else the first of t, time, timestamp.
+pub fn time_column(table: &Table, explicit: Option<&str>) -> Result<Option<usize>> {
+    match explicit {
+        Some(name) => table.require(name, "--time", "time").map(Some),
+        None => Ok(["t", "time", "timestamp"]
+            .iter()
+            .find_map(|n| table.find(n))),
+    }
+}
+
+/// Read two columns (e.g. op and mv) ready for estimation, with the checks that apply to both.
+pub fn read_pair(
+    path: &Path,
+    (a_name, a_flag, a_role): (&str, &str, &str),
+    (b_name, b_flag, b_role): (&str, &str, &str),
+    min_samples: usize,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let table = Table::read(path)?;
+    let a = table.require(a_name, a_flag, a_role)?;
+    let b = table.require(b_name, b_flag, b_role)?;
+    if table.len() < min_samples {
+        bail!(
+            "{}: only {} rows of data; estimation needs at least {min_samples} samples",
+            path.display(),
+            table.len()
+        );
+    }
+    let av = table.numbers(a)?;
+    let bv = table.numbers(b)?;
+    let (lo, hi) = av
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+    if hi - lo <= 0.0 {
+        bail!(
+            "{}: column '{}' ({a_role}) is constant at {lo}; a valve whose command never moves shows no stiction, choose a stretch of data where {a_role} varies",
+            path.display(),
+            table.headers[a]
+        );
+    }
+    Ok((av, bv))
+}

@@ -1,0 +1,189 @@
+//! Charts as PNG and SVG. Plotting takes finished result data; it never computes.
+
+use anyhow::{anyhow, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+/// DejaVu Sans, embedded so charts need no system fonts (licence in assets/).
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+static REGISTER: Once = Once::new();
+
+fn register_font() {
+    REGISTER.call_once(|| {
+        for style in [FontStyle::Normal, FontStyle::Bold] {
+            // the embedded font is valid; a failure here would only cost the text
+            let _ = plotters::style::register_font("sans-serif", style, FONT);
+        }
+    });
+}
+
+#[derive(Clone, Copy, PartialEq)]
+pub enum Kind {
+    Line,
+    /// A staircase: holds each value until the next sample (valve positions).
+    Step,
+}
+
+pub struct Series<'a> {
+    pub label: String,
+    pub x: &'a [f64],
+    pub y: &'a [f64],
+    pub kind: Kind,
+    /// Index into the palette.
+    pub color: usize,
+    /// Thin, unlabelled lines (e.g. one per seed) show in the legend once via `label`.
+    pub thin: bool,
+}
+
+/// A horizontal band or line with a legend entry.
+pub struct HBand {
+    pub lo: f64,
+    pub hi: f64,
+    pub label: String,
+    pub color: usize,
+}
+
+pub struct Chart<'a> {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series<'a>>,
+    pub bands: Vec<HBand>,
+    /// Fix the y range instead of fitting the data.
+    pub y_range: Option<(f64, f64)>,
+}
+
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(90, 90, 90),
+];
+
+fn color(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// Write `stem.png` and `stem.svg`; returns both paths.
+pub fn save(chart: &Chart, stem: &Path) -> Result<Vec<PathBuf>> {
+    register_font();
+    let png = stem.with_extension("png");
+    let svg = stem.with_extension("svg");
+    let size = (1000, 600);
+    draw(BitMapBackend::new(&png, size).into_drawing_area(), chart)
+        .map_err(|e| anyhow!("{}: cannot draw the chart: {e}", png.display()))?;
+    draw(SVGBackend::new(&svg, size).into_drawing_area(), chart)
+        .map_err(|e| anyhow!("{}: cannot draw the chart: {e}", svg.display()))?;
+    Ok(vec![png, svg])
+}
+
+fn bounds(chart: &Chart) -> ((f64, f64), (f64, f64)) {
+    let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut yr = xr;
+    for s in &chart.series {
+        for (&x, &y) in s.x.iter().zip(s.y) {
+            if x.is_finite() && y.is_finite() {
+                xr = (xr.0.min(x), xr.1.max(x));
+                yr = (yr.0.min(y), yr.1.max(y));
+            }
+        }
+    }
+    for b in &chart.bands {
+        yr = (yr.0.min(b.lo), yr.1.max(b.hi));
+    }
+    if !xr.0.is_finite() {
+        xr = (0.0, 1.0);
+        yr = (0.0, 1.0);
+    }
+    if let Some(r) = chart.y_range {
+        yr = r;
+    }
+    let pad = |(lo, hi): (f64, f64), frac: f64| {
+        let w = if hi > lo { hi - lo } else { lo.abs().max(1.0) };
+        (lo - frac * w, hi + frac * w)
+    };
+    let xr = if xr.1 > xr.0 { xr } else { pad(xr, 0.5) };
+    (xr, pad(yr, 0.08))
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    c: &Chart,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    root.fill(&WHITE)?;
+    let ((x0, x1), (y0, y1)) = bounds(c);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&c.title, ("sans-serif", 24))
+        .margin(16)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, y0..y1)?;
+    chart
+        .configure_mesh()
+        .x_desc(c.x_label.as_str())
+        .y_desc(c.y_label.as_str())
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 17))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()?;
+    for b in &c.bands {
+        let col = color(b.color);
+        let style = if b.hi > b.lo {
+            col.mix(0.25).filled()
+        } else {
+            col.stroke_width(2)
+        };
+        let rect = if b.hi > b.lo {
+            Rectangle::new([(x0, b.lo), (x1, b.hi)], style)
+        } else {
+            Rectangle::new([(x0, b.lo), (x1, b.lo)], style)
+        };
+        chart
+            .draw_series(std::iter::once(rect))?
+            .label(b.label.as_str())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], col.mix(0.4).filled()));
+    }
+    let mut labelled = std::collections::HashSet::new();
+    for s in &c.series {
+        let col = color(s.color);
+        // a 2-pixel line looks ragged on dense series in the bitmap backend
+        let width = if s.thin || s.x.len() > 300 { 1 } else { 2 };
+        let style = if s.thin {
+            col.mix(0.55).stroke_width(width)
+        } else {
+            col.stroke_width(width)
+        };
+        let pts: Vec<(f64, f64)> = s.x.iter().copied().zip(s.y.iter().copied()).collect();
+        let anno = match s.kind {
+            Kind::Line => chart.draw_series(LineSeries::new(pts, style))?,
+            Kind::Step => {
+                let mut stairs = Vec::with_capacity(pts.len() * 2);
+                for (i, &(x, y)) in pts.iter().enumerate() {
+                    if i > 0 {
+                        stairs.push((x, pts[i - 1].1));
+                    }
+                    stairs.push((x, y));
+                }
+                chart.draw_series(LineSeries::new(stairs, style))?
+            }
+        };
+        if !s.label.is_empty() && labelled.insert(s.label.clone()) {
+            anno.label(s.label.as_str()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(3))
+            });
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 15))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(160, 160, 160))
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
