@@ -89,7 +89,9 @@ pub struct Args {
 pub fn run(a: Args) -> Result<()> {
     let kind = spec::model_kind(&a.model)?;
     let method = match &a.method {
-        Some(m) => m.parse::<Method>().map_err(|e| anyhow::anyhow!("--method: {e}"))?,
+        Some(m) => m
+            .parse::<Method>()
+            .map_err(|e| anyhow::anyhow!("--method: {e}"))?,
         None => Method::default_for(kind),
     };
     let mut req = Request::new(kind, method);
@@ -152,12 +154,21 @@ fn bounds(kind: ModelKind, a: &Args) -> Result<Option<Vec<(f64, f64)>>> {
     for text in &a.bounds {
         let parsed = text.split_once('=').and_then(|(n, r)| {
             let (lo, hi) = r.split_once(':')?;
-            Some((n.trim(), lo.trim().parse::<f64>().ok()?, hi.trim().parse::<f64>().ok()?))
+            Some((
+                n.trim(),
+                lo.trim().parse::<f64>().ok()?,
+                hi.trim().parse::<f64>().ok()?,
+            ))
         });
         let (name, lo, hi) = parsed.with_context(|| {
-            format!("--bounds {text}: write NAME=LO:HI, e.g. --bounds {}=0.01:10", kind.param_names()[0])
+            format!(
+                "--bounds {text}: write NAME=LO:HI, e.g. --bounds {}=0.01:10",
+                kind.param_names()[0]
+            )
         })?;
-        let i = kind.param_index(name).map_err(|e| anyhow::anyhow!("--bounds: {e}"))?;
+        let i = kind
+            .param_index(name)
+            .map_err(|e| anyhow::anyhow!("--bounds: {e}"))?;
         b[i] = (lo, hi);
     }
     Ok(Some(b))
@@ -196,19 +207,24 @@ fn print_human(file: &str, e: &Estimate) {
     );
     for spec in e.model.params() {
         let v = e.params[spec.name];
-        print!("  {} = {v:.4} {} ({})", spec.name, spec.unit, spec.description);
+        print!(
+            "  {} = {v:.4} {} ({})",
+            spec.name, spec.unit, spec.description
+        );
         if let Some([lo, hi]) = e.interval.get(spec.name) {
-            let what = if e.interval_kind == "exact" {
-                "proven optimal set"
+            if e.interval_kind == "exact" {
+                print!("; proven optimal set [{lo:.4}, {hi:.4})");
             } else {
-                "grid points at the minimum"
-            };
-            print!("; {what} [{lo:.4}, {hi:.4}]");
+                print!("; grid points at the minimum span [{lo:.4}, {hi:.4}]");
+            }
         }
         println!();
     }
     if let Some(pieces) = &e.pieces {
-        let p: Vec<String> = pieces.iter().map(|[a, b]| format!("[{a:.4}, {b:.4})")).collect();
+        let p: Vec<String> = pieces
+            .iter()
+            .map(|[a, b]| format!("[{a:.4}, {b:.4})"))
+            .collect();
         println!("  the optimal set is not one piece: {}", p.join(" U "));
     }
     if let Some(c) = &e.certificate {
@@ -228,7 +244,11 @@ fn print_human(file: &str, e: &Estimate) {
         "  {} evaluations, {} {}, {:.2} ms",
         e.evaluations,
         e.iterations,
-        if e.method == Method::Exact { "cells" } else { "iterations" },
+        if e.method == Method::Exact {
+            "cells"
+        } else {
+            "iterations"
+        },
         e.seconds * 1e3
     );
     for w in &e.warnings {

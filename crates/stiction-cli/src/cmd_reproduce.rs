@@ -23,7 +23,10 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<()> {
     if a.what != "paper" {
-        bail!("reproduce: unknown target '{}'; the one target is 'paper'", a.what);
+        bail!(
+            "reproduce: unknown target '{}'; the one target is 'paper'",
+            a.what
+        );
     }
     if a.seeds == 0 {
         bail!("--seeds must be at least 1");
@@ -79,7 +82,11 @@ fn print_table(rep: &PaperReproduction) {
         "case", "true d", "paper", "ours", "worst", "exact optimal set", "seeds inside", "ms/run"
     );
     for c in &rep.cases {
-        let label = if c.true_d < 0.3 { "weak stiction" } else { "strong stiction" };
+        let label = if c.true_d < 0.3 {
+            "weak stiction"
+        } else {
+            "strong stiction"
+        };
         println!(
             "  {:<16} {:>6} {:>8} | {:>8.4} {:>8.4} {:>21} {:>14} {:>9.3}",
             label,
@@ -93,7 +100,9 @@ fn print_table(rep: &PaperReproduction) {
         );
     }
     println!();
-    println!("  'ours' is the mean estimate over seeds; 'worst' the estimate farthest from the true d.");
+    println!(
+        "  'ours' is the mean estimate over seeds; 'worst' the estimate farthest from the true d."
+    );
     for c in &rep.cases {
         println!(
             "  d = {}: the true d {} in the optimal set; the paper's {} {}.",
@@ -123,12 +132,29 @@ fn figures(rep: &PaperReproduction, out: &Path) -> Result<Vec<PathBuf>> {
 
 fn response_figure(c: &PaperCase, fig: usize, name: &str, out: &Path) -> Result<Vec<PathBuf>> {
     let chart = Chart {
-        title: format!("Fig. {fig}: open-loop response, Stenman valve, {name} stiction (d = {})", c.true_d),
+        title: format!(
+            "Fig. {fig}: open-loop response, Stenman valve, {name} stiction (d = {})",
+            c.true_d
+        ),
         x_label: "time (s)".into(),
         y_label: "% of valve span".into(),
         series: vec![
-            Series { label: "command op".into(), x: &c.data.t, y: &c.data.op, kind: Kind::Line, color: 0, thin: false },
-            Series { label: "valve position mv".into(), x: &c.data.t, y: &c.data.mv, kind: Kind::Step, color: 1, thin: false },
+            Series {
+                label: "command op".into(),
+                x: &c.data.t,
+                y: &c.data.op,
+                kind: Kind::Line,
+                color: 0,
+                thin: false,
+            },
+            Series {
+                label: "valve position mv".into(),
+                x: &c.data.t,
+                y: &c.data.mv,
+                kind: Kind::Step,
+                color: 1,
+                thin: false,
+            },
         ],
         bands: vec![],
         y_range: None,
@@ -186,7 +212,10 @@ fn trajectory_figure(c: &PaperCase, fig: usize, name: &str, out: &Path) -> Resul
     // zoom on the answer: early excursions of a few seeds (up to 10) would flatten the picture
     let top = 3.0 * c.true_d;
     let chart = Chart {
-        title: format!("Fig. {}: trajectories of the estimated d, {name} stiction (d = {})", fig, c.true_d),
+        title: format!(
+            "Fig. {}: trajectories of the estimated d, {name} stiction (d = {})",
+            fig, c.true_d
+        ),
         // (the y axis stops at 3 x true d)
         x_label: "iteration".into(),
         y_label: "estimated d (% of span)".into(),
@@ -195,10 +224,18 @@ fn trajectory_figure(c: &PaperCase, fig: usize, name: &str, out: &Path) -> Resul
             HBand {
                 lo: c.interval[0],
                 hi: c.interval[1],
-                label: format!("exact optimal set [{:.4}, {:.4})", c.interval[0], c.interval[1]),
+                label: format!(
+                    "exact optimal set [{:.4}, {:.4})",
+                    c.interval[0], c.interval[1]
+                ),
                 color: 2,
             },
-            HBand { lo: c.true_d, hi: c.true_d, label: format!("true d = {}", c.true_d), color: 1 },
+            HBand {
+                lo: c.true_d,
+                hi: c.true_d,
+                label: format!("true d = {}", c.true_d),
+                color: 1,
+            },
         ],
         y_range: Some((0.0, top)),
     };

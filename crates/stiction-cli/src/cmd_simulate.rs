@@ -70,7 +70,10 @@ pub fn run(a: Args) -> Result<()> {
         bail!("--samples {samples}: simulate at least 2 samples");
     }
     if !(a.noise >= 0.0 && a.noise.is_finite()) {
-        bail!("--noise {}: the noise standard deviation must be >= 0", a.noise);
+        bail!(
+            "--noise {}: the noise standard deviation must be >= 0",
+            a.noise
+        );
     }
     let data = if closed {
         let mut cl = ClosedLoop::new(model);
@@ -144,5 +147,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     f.write_all(bytes)
         .with_context(|| format!("{}: cannot write the file", path.display()))?;
     drop(f);
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot write the file", path.display()))
+    std::fs::rename(&tmp, path)
+        .with_context(|| format!("{}: cannot write the file", path.display()))
 }

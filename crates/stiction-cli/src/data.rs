@@ -46,8 +46,8 @@ impl Table {
         let mut rows = Vec::new();
         let mut lines = Vec::new();
         for record in reader.records() {
-            let record = record
-                .with_context(|| format!("{}: not a readable CSV file", path.display()))?;
+            let record =
+                record.with_context(|| format!("{}: not a readable CSV file", path.display()))?;
             let line = record.position().map(|p| p.line()).unwrap_or(0);
             if record.iter().all(|c| c.trim().is_empty()) {
                 continue; // blank line
@@ -170,7 +170,9 @@ pub fn read_pair(
     let bv = table.numbers(b)?;
     let (lo, hi) = av
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
     if hi - lo <= 0.0 {
         bail!(
             "{}: column '{}' ({a_role}) is constant at {lo}; a valve whose command never moves shows no stiction, choose a stretch of data where {a_role} varies",

@@ -145,7 +145,9 @@ fn draw<DB: DrawingBackend>(
         chart
             .draw_series(std::iter::once(rect))?
             .label(b.label.as_str())
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], col.mix(0.4).filled()));
+            .legend(move |(x, y)| {
+                Rectangle::new([(x, y - 5), (x + 20, y + 5)], col.mix(0.4).filled())
+            });
     }
     let mut labelled = std::collections::HashSet::new();
     for s in &c.series {

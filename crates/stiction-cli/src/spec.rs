@@ -10,18 +10,29 @@ pub fn pairs(text: &str, what: &str, known: &[&str]) -> Result<Vec<(String, f64)
     let mut out: Vec<(String, f64)> = Vec::new();
     for item in text.split([',', ' ']).filter(|s| !s.trim().is_empty()) {
         let Some((name, value)) = item.split_once('=') else {
-            bail!("{what}: '{item}' is not NAME=VALUE; write e.g. {}=1", known.first().unwrap_or(&"x"))
+            bail!(
+                "{what}: '{item}' is not NAME=VALUE; write e.g. {}=1",
+                known.first().unwrap_or(&"x")
+            )
         };
         let name = name.trim();
         let canonical = known
             .iter()
             .find(|k| k.eq_ignore_ascii_case(name))
             .with_context(|| {
-                format!("{what}: unknown name '{name}'; the names are {}", known.join(", "))
+                format!(
+                    "{what}: unknown name '{name}'; the names are {}",
+                    known.join(", ")
+                )
             })?;
-        let value: f64 = value.trim().parse().ok().filter(|v: &f64| v.is_finite()).with_context(|| {
-            format!("{what}: {name} = '{}' is not a finite number", value.trim())
-        })?;
+        let value: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .with_context(|| {
+                format!("{what}: {name} = '{}' is not a finite number", value.trim())
+            })?;
         if out.iter().any(|(n, _)| n == canonical) {
             bail!("{what}: {name} is given twice");
         }
@@ -31,7 +42,9 @@ pub fn pairs(text: &str, what: &str, known: &[&str]) -> Result<Vec<(String, f64)
 }
 
 fn get(p: &[(String, f64)], name: &str, default: f64) -> f64 {
-    p.iter().find(|(n, _)| n == name).map_or(default, |(_, v)| *v)
+    p.iter()
+        .find(|(n, _)| n == name)
+        .map_or(default, |(_, v)| *v)
 }
 
 /// `KIND:k=v,...` into a signal. Unnamed settings take the defaults shown in `--help`.
@@ -113,11 +126,15 @@ pub fn process(text: &str) -> Result<Process> {
 /// `Kc=0.2,Ti=10`.
 pub fn pi(text: &str) -> Result<Pi> {
     let p = pairs(text, &format!("--pi {text}"), &["Kc", "Ti"])?;
-    Ok(Pi { kc: get(&p, "Kc", 0.2), ti: get(&p, "Ti", 10.0) })
+    Ok(Pi {
+        kc: get(&p, "Kc", 0.2),
+        ti: get(&p, "Ti", 10.0),
+    })
 }
 
 pub fn model_kind(text: &str) -> Result<ModelKind> {
-    text.parse::<ModelKind>().map_err(|e| anyhow::anyhow!("--model: {e}"))
+    text.parse::<ModelKind>()
+        .map_err(|e| anyhow::anyhow!("--model: {e}"))
 }
 
 /// A model from `--param NAME=VALUE` flags (each flag may hold several, comma-separated).
@@ -134,16 +151,21 @@ pub fn model(kind: ModelKind, params: &[String]) -> Result<Model> {
     }
     let mut values = Vec::new();
     for spec in kind.params() {
-        let v = given.iter().find(|(n, _)| n == spec.name).map(|(_, v)| *v).with_context(|| {
-            format!(
-                "model {kind} needs --param {}=VALUE ({}, {}); its parameters are {}",
-                spec.name,
-                spec.description,
-                spec.unit,
-                names.join(", ")
-            )
-        })?;
+        let v = given
+            .iter()
+            .find(|(n, _)| n == spec.name)
+            .map(|(_, v)| *v)
+            .with_context(|| {
+                format!(
+                    "model {kind} needs --param {}=VALUE ({}, {}); its parameters are {}",
+                    spec.name,
+                    spec.description,
+                    spec.unit,
+                    names.join(", ")
+                )
+            })?;
         values.push(v);
     }
-    kind.build(&values).map_err(|e| anyhow::anyhow!("--param: {e}"))
+    kind.build(&values)
+        .map_err(|e| anyhow::anyhow!("--param: {e}"))
 }

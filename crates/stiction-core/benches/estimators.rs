@@ -9,11 +9,23 @@ use stiction_core::sim::{simulate_open_loop, LoopData, Signal};
 
 fn paper_case(d: f64) -> LoopData {
     let s = PaperSetup::default();
-    simulate_open_loop(&Model::Stenman(Stenman { d }), &s.signal, s.ts, s.samples, 0.0, 0).unwrap()
+    simulate_open_loop(
+        &Model::Stenman(Stenman { d }),
+        &s.signal,
+        s.ts,
+        s.samples,
+        0.0,
+        0,
+    )
+    .unwrap()
 }
 
 fn random_walk(n: usize) -> LoopData {
-    let walk = Signal::RandomWalk { step_std: 0.1, offset: 0.0, seed: 3 };
+    let walk = Signal::RandomWalk {
+        step_std: 0.1,
+        offset: 0.0,
+        seed: 3,
+    };
     simulate_open_loop(&Model::Stenman(Stenman { d: 0.5 }), &walk, 1.0, n, 0.05, 3).unwrap()
 }
 
@@ -39,7 +51,15 @@ fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("random_walk_100k_noise_0.05");
     g.sample_size(10);
     g.bench_function("exact", |b| {
-        b.iter(|| exact::solve_stenman(black_box(&walk.op), black_box(&walk.mv), 0.01, 10.0, &Default::default()))
+        b.iter(|| {
+            exact::solve_stenman(
+                black_box(&walk.op),
+                black_box(&walk.mv),
+                0.01,
+                10.0,
+                &Default::default(),
+            )
+        })
     });
     g.finish();
 }

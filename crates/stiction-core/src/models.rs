@@ -62,7 +62,11 @@ pub trait StictionModel: Copy + Send + Sync {
 
     /// Simulate the valve position for a whole command sequence into `mv` (same length as `op`).
     fn simulate_into(&self, op: &[f64], mv: &mut [f64]) {
-        assert_eq!(op.len(), mv.len(), "op and mv buffers must have the same length");
+        assert_eq!(
+            op.len(),
+            mv.len(),
+            "op and mv buffers must have the same length"
+        );
         if op.is_empty() {
             return;
         }

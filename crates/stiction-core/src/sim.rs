@@ -305,9 +305,24 @@ impl ClosedLoop {
         if let Some(d) = &self.disturbance {
             d.validate()?;
         }
-        require(self.ts > 0.0, "the sampling time ts", "> 0 seconds", self.ts)?;
-        require(self.pi.kc != 0.0, "controller gain Kc", "non-zero", self.pi.kc)?;
-        require(self.pi.ti > 0.0, "integral time Ti", "> 0 seconds", self.pi.ti)?;
+        require(
+            self.ts > 0.0,
+            "the sampling time ts",
+            "> 0 seconds",
+            self.ts,
+        )?;
+        require(
+            self.pi.kc != 0.0,
+            "controller gain Kc",
+            "non-zero",
+            self.pi.kc,
+        )?;
+        require(
+            self.pi.ti > 0.0,
+            "integral time Ti",
+            "> 0 seconds",
+            self.pi.ti,
+        )?;
         require(self.noise >= 0.0, "noise", ">= 0", self.noise)?;
         require(
             (0.0..=100.0).contains(&self.op0),

@@ -3,13 +3,18 @@
 
 use proptest::prelude::*;
 use stiction_core::estimate::{estimate, exact, Method, Objective, Request};
-use stiction_core::models::{Kano, Model, ModelKind, Stenman, StictionModel};
+use stiction_core::models::{Kano, Model, ModelKind, Stenman};
 use stiction_core::reproduce::{reproduce_paper, PaperSetup};
 use stiction_core::sim::{simulate_open_loop, Signal};
 
 fn walk(n: usize, d: f64, noise: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
-    let s = Signal::RandomWalk { step_std: 0.3, offset: 50.0, seed };
-    let data = simulate_open_loop(&Model::Stenman(Stenman { d }), &s, 1.0, n, noise, seed + 1).unwrap();
+    let s = Signal::RandomWalk {
+        step_std: 0.3,
+        offset: 50.0,
+        seed,
+    };
+    let data =
+        simulate_open_loop(&Model::Stenman(Stenman { d }), &s, 1.0, n, noise, seed + 1).unwrap();
     (data.op, data.mv)
 }
 
@@ -81,7 +86,11 @@ fn every_method_recovers_stenman_d() {
 
 #[test]
 fn acor_recovers_a_kano_valve() {
-    let s = Signal::Sine { amplitude: 10.0, period: 50.0, offset: 50.0 };
+    let s = Signal::Sine {
+        amplitude: 10.0,
+        period: 50.0,
+        offset: 50.0,
+    };
     let truth = Model::Kano(Kano { s: 4.0, j: 1.0 });
     let data = simulate_open_loop(&truth, &s, 0.5, 600, 0.0, 0).unwrap();
     let mut req = Request::new(ModelKind::Kano, Method::AcoR);
@@ -111,7 +120,10 @@ fn results_do_not_depend_on_the_thread_count() {
     // large enough that batches are spread over threads
     let (op, mv) = walk(6000, 0.9, 0.1, 8);
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let mut out = Vec::new();
             for (kind, method) in [
@@ -137,17 +149,32 @@ fn bad_requests_are_refused() {
     let (op, mv) = walk(100, 0.5, 0.0, 1);
     let mut req = Request::new(ModelKind::Stenman, Method::Grid);
     req.bounds = Some(vec![(-1.0, 2.0)]);
-    assert!(estimate(&op, &mv, &req).unwrap_err().to_string().contains("negative"));
+    assert!(estimate(&op, &mv, &req)
+        .unwrap_err()
+        .to_string()
+        .contains("negative"));
     req.bounds = Some(vec![(2.0, 1.0)]);
-    assert!(estimate(&op, &mv, &req).unwrap_err().to_string().contains("reversed"));
+    assert!(estimate(&op, &mv, &req)
+        .unwrap_err()
+        .to_string()
+        .contains("reversed"));
     let req = Request::new(ModelKind::Kano, Method::Exact);
     assert!(estimate(&op, &mv, &req).is_err());
     let req = Request::new(ModelKind::Stenman, Method::Exact);
-    assert!(estimate(&op[..5], &mv[..5], &req).unwrap_err().to_string().contains("at least 10"));
-    assert!(estimate(&[1.0; 20], &[1.0; 20], &req).unwrap_err().to_string().contains("constant"));
+    assert!(estimate(&op[..5], &mv[..5], &req)
+        .unwrap_err()
+        .to_string()
+        .contains("at least 10"));
+    assert!(estimate(&[1.0; 20], &[1.0; 20], &req)
+        .unwrap_err()
+        .to_string()
+        .contains("constant"));
     let mut nan = mv.clone();
     nan[7] = f64::NAN;
-    assert!(estimate(&op, &nan, &req).unwrap_err().to_string().contains("sample 7"));
+    assert!(estimate(&op, &nan, &req)
+        .unwrap_err()
+        .to_string()
+        .contains("sample 7"));
 }
 
 #[test]
@@ -155,8 +182,16 @@ fn the_paper_reproduces_with_every_seed_optimal() {
     let rep = reproduce_paper(&PaperSetup::default());
     assert_eq!(rep.cases.len(), 2);
     for c in &rep.cases {
-        assert!(c.true_d_inside, "true d {} outside {:?}", c.true_d, c.interval);
-        assert_eq!(c.inside, 20, "d = {}: {:?} vs {:?}", c.true_d, c.estimates, c.interval);
+        assert!(
+            c.true_d_inside,
+            "true d {} outside {:?}",
+            c.true_d, c.interval
+        );
+        assert_eq!(
+            c.inside, 20,
+            "d = {}: {:?} vs {:?}",
+            c.true_d, c.estimates, c.interval
+        );
         assert_eq!(c.traces.len(), 20);
         assert_eq!(c.traces[0].len(), 100);
     }

@@ -133,13 +133,39 @@ fn choudhury_regimes() {
     // J = 0: unlike Kano, the zero-velocity sample at 55 counts as a stop and the next move as a
     // reversal, so the valve holds one sample longer
     let cases: [((f64, f64), [f64; 16]); 4] = [
-        ((2.0, 0.0), [50., 50., 50., 52., 53., 54., 54., 54., 56., 57., 57., 57., 56., 55., 54., 53.]),
-        ((2.0, 1.0), [50., 50., 50., 52.5, 53.5, 54.5, 54.5, 54.5, 56.5, 57.5, 57.5, 57.5, 55.5, 54.5, 53.5, 52.5]),
-        ((2.0, 2.0), [50., 50., 50., 53., 54., 55., 55., 55., 55., 58., 58., 58., 55., 54., 53., 52.]),
-        ((2.0, 3.0), [50., 50., 50., 53.5, 54.5, 55.5, 55.5, 55.5, 55.5, 55.5, 55.5, 55.5, 55.5, 53.5, 52.5, 51.5]),
+        (
+            (2.0, 0.0),
+            [
+                50., 50., 50., 52., 53., 54., 54., 54., 56., 57., 57., 57., 56., 55., 54., 53.,
+            ],
+        ),
+        (
+            (2.0, 1.0),
+            [
+                50., 50., 50., 52.5, 53.5, 54.5, 54.5, 54.5, 56.5, 57.5, 57.5, 57.5, 55.5, 54.5,
+                53.5, 52.5,
+            ],
+        ),
+        (
+            (2.0, 2.0),
+            [
+                50., 50., 50., 53., 54., 55., 55., 55., 55., 58., 58., 58., 55., 54., 53., 52.,
+            ],
+        ),
+        (
+            (2.0, 3.0),
+            [
+                50., 50., 50., 53.5, 54.5, 55.5, 55.5, 55.5, 55.5, 55.5, 55.5, 55.5, 55.5, 53.5,
+                52.5, 51.5,
+            ],
+        ),
     ];
     for ((s, j), want) in cases {
-        assert_eq!(run(Choudhury::new(s, j).unwrap(), &RAMP), want, "S = {s}, J = {j}");
+        assert_eq!(
+            run(Choudhury::new(s, j).unwrap(), &RAMP),
+            want,
+            "S = {s}, J = {j}"
+        );
     }
 }
 
@@ -155,8 +181,15 @@ fn choudhury_velocity_deadzone_ignores_jitter() {
     let stuck = run(m, &u);
     m.velocity_deadzone = 0.35;
     let moving = run(m, &u);
-    assert!(stuck.iter().all(|&x| x == stuck[0]), "jitter keeps the published model stuck");
-    assert!(moving[39] > 53.0, "with a dead zone the valve follows the ramp: {}", moving[39]);
+    assert!(
+        stuck.iter().all(|&x| x == stuck[0]),
+        "jitter keeps the published model stuck"
+    );
+    assert!(
+        moving[39] > 53.0,
+        "with a dead zone the valve follows the ramp: {}",
+        moving[39]
+    );
 }
 
 #[test]

@@ -122,14 +122,21 @@ impl PaperAco {
     fn local_search(&mut self, a: usize, ev: &mut Evaluator) {
         let dim = self.nodes.len();
         let max_steps = self.settings.local_search;
-        if max_steps == 0 || !self.searched.insert(self.picks[a * dim..(a + 1) * dim].to_vec()) {
+        if max_steps == 0
+            || !self
+                .searched
+                .insert(self.picks[a * dim..(a + 1) * dim].to_vec())
+        {
             return;
         }
         for p in 0..dim {
             let start = self.picks[a * dim + p];
             let last = self.nodes[p].len() - 1;
             // per direction: (current node, its cost, still walking)
-            let mut walk = [(start, self.costs[a], start > 0), (start, self.costs[a], start < last)];
+            let mut walk = [
+                (start, self.costs[a], start > 0),
+                (start, self.costs[a], start < last),
+            ];
             let mut best: Option<(usize, f64)> = None;
             let mut best_params = [0.0; 8];
             for _ in 0..max_steps {

@@ -161,7 +161,9 @@ impl Request {
                 return Err(err("the lower end must not be negative"));
             }
             if lo >= hi {
-                return Err(err("the lower end must be below the upper end (reversed or empty)"));
+                return Err(err(
+                    "the lower end must be below the upper end (reversed or empty)",
+                ));
             }
         }
         Ok(bounds)
@@ -175,17 +177,16 @@ impl Request {
                 if s.ants == 0 || s.iterations == 0 {
                     return bad("--ants and --iterations must be at least 1");
                 }
-                if !(s.rho > 0.0 && s.rho < 1.0) {
+                if !(positive(s.rho) && s.rho < 1.0) {
                     return bad("--rho (evaporation) must be between 0 and 1, exclusive");
                 }
-                if !(s.q > 0.0 && s.q.is_finite()) || !(s.elitist >= 0.0 && s.elitist.is_finite())
-                {
+                if !positive(s.q) || !(s.elitist == 0.0 || positive(s.elitist)) {
                     return bad("--q must be > 0 and --elitist >= 0");
                 }
-                if !(s.resolution > 0.0 && s.resolution.is_finite()) {
+                if !positive(s.resolution) {
                     return bad("--resolution must be > 0");
                 }
-                if !(s.tau0 > 0.0 && s.tau0.is_finite()) || !(s.epsilon > 0.0) {
+                if !positive(s.tau0) || !positive(s.epsilon) {
                     return bad("--tau0 and --epsilon must be > 0");
                 }
             }
@@ -194,7 +195,7 @@ impl Request {
                 if s.ants == 0 || s.iterations == 0 || s.archive < 2 {
                     return bad("--ants and --iterations must be at least 1, --archive at least 2");
                 }
-                if !(s.q > 0.0) || !(s.xi > 0.0) {
+                if !positive(s.q) || !positive(s.xi) {
                     return bad("--q and --xi must be > 0");
                 }
             }
@@ -211,6 +212,10 @@ impl Request {
         }
         Ok(())
     }
+}
+
+fn positive(x: f64) -> bool {
+    x > 0.0 && x.is_finite()
 }
 
 /// The result of an estimation, shared by every front end.
@@ -333,7 +338,10 @@ pub fn estimate(op: &[f64], mv: &[f64], req: &Request) -> Result<Estimate, Estim
         Method::Grid => {
             let g = grid::search(&objective, &bounds, &req.grid);
             for (p, name) in names.iter().enumerate() {
-                interval.insert(name.to_string(), [g.minimisers_hull[p].0, g.minimisers_hull[p].1]);
+                interval.insert(
+                    name.to_string(),
+                    [g.minimisers_hull[p].0, g.minimisers_hull[p].1],
+                );
             }
             interval_kind = "grid";
             (g.best, g.sse, g.evaluations, 1)
@@ -360,17 +368,18 @@ pub fn estimate(op: &[f64], mv: &[f64], req: &Request) -> Result<Estimate, Estim
         }
     };
 
-    let certificate = if req.certify && req.model == ModelKind::Stenman && req.method != Method::Exact {
-        let (lo, hi) = bounds[0];
-        let sol = exact::solve_stenman(op, mv, lo, hi, &req.exact);
-        Some(Certificate {
-            optimal_interval: [sol.hull().0, sol.hull().1],
-            optimal_sse: sol.sse,
-            estimate_is_optimal: sol.contains(best[0]),
-        })
-    } else {
-        None
-    };
+    let certificate =
+        if req.certify && req.model == ModelKind::Stenman && req.method != Method::Exact {
+            let (lo, hi) = bounds[0];
+            let sol = exact::solve_stenman(op, mv, lo, hi, &req.exact);
+            Some(Certificate {
+                optimal_interval: [sol.hull().0, sol.hull().1],
+                optimal_sse: sol.sse,
+                estimate_is_optimal: sol.contains(best[0]),
+            })
+        } else {
+            None
+        };
     let seconds = started.elapsed().as_secs_f64();
 
     let n = mv.len() as f64;

@@ -121,7 +121,11 @@ fn batch_sse<M: FromValues>(op: &[f64], mv: &[f64], dim: usize, cands: &[f64], o
 
 /// One pass over the data advancing `N` models side by side.
 #[inline]
-fn sse_lanes<M: StictionModel, const N: usize>(models: &[M; N], op: &[f64], mv: &[f64]) -> [f64; N] {
+fn sse_lanes<M: StictionModel, const N: usize>(
+    models: &[M; N],
+    op: &[f64],
+    mv: &[f64],
+) -> [f64; N] {
     let mut sums = [0.0f64; N];
     let mut states: [M::State; N] = std::array::from_fn(|l| {
         let (state, x0) = models[l].start(op[0]);
@@ -155,7 +159,9 @@ fn batch_sse_stenman(op: &[f64], mv: &[f64], ds: &[f64], out: &mut [f64]) {
     };
     let (head, tail) = out.split_at_mut(full);
     if op.len() * count >= PARALLEL_WORK {
-        head.par_chunks_mut(STENMAN_LANES).enumerate().for_each(work);
+        head.par_chunks_mut(STENMAN_LANES)
+            .enumerate()
+            .for_each(work);
     } else {
         head.chunks_mut(STENMAN_LANES).enumerate().for_each(work);
     }

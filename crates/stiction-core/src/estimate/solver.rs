@@ -43,7 +43,8 @@ impl<'a> Evaluator<'a> {
         for (i, &c) in costs.iter().enumerate() {
             if c < self.best_cost {
                 self.best_cost = c;
-                self.best.copy_from_slice(&candidates[i * dim..(i + 1) * dim]);
+                self.best
+                    .copy_from_slice(&candidates[i * dim..(i + 1) * dim]);
             }
         }
     }

@@ -1,0 +1,478 @@
+//! The command line as a user types it: the binary is spawned, its output read.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn stiction(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stiction"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = stiction(args);
+    assert!(
+        out.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Runs a command that must fail with one clear line on stderr containing every `needles`.
+fn fails(args: &[&str], needles: &[&str]) {
+    let out = stiction(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} should fail");
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    assert_eq!(
+        err.trim().lines().count(),
+        1,
+        "{args:?}: not one line: {err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: '{n}' missing from: {err}");
+    }
+}
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+fn json(text: &str) -> serde_json::Value {
+    serde_json::from_str(text).expect("valid JSON")
+}
+
+fn simulate_open(dir: &Path, d: &str) -> String {
+    let p: PathBuf = dir.join("open.csv");
+    let path = p.to_str().unwrap();
+    ok(&[
+        "simulate",
+        "--model",
+        "stenman",
+        "--param",
+        &format!("d={d}"),
+        "-o",
+        path,
+    ]);
+    path.to_string()
+}
+
+#[test]
+fn simulate_then_estimate_exact() {
+    let dir = tmp();
+    let file = simulate_open(dir.path(), "0.5");
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.starts_with("t,sp,op,mv,pv\n"));
+    assert_eq!(text.lines().count(), 1002);
+    let v = json(&ok(&[
+        "estimate", &file, "--op", "op", "--mv", "mv", "--model", "stenman", "--method", "exact",
+        "--json",
+    ]));
+    for key in [
+        "model",
+        "method",
+        "params",
+        "interval",
+        "sse",
+        "evaluations",
+        "seconds",
+    ] {
+        assert!(v.get(key).is_some(), "no {key} in {v}");
+    }
+    let [lo, hi] = [
+        v["interval"]["d"][0].as_f64().unwrap(),
+        v["interval"]["d"][1].as_f64().unwrap(),
+    ];
+    assert!(lo <= 0.5 && 0.5 <= hi, "[{lo}, {hi}]");
+    assert_eq!(v["sse"].as_f64().unwrap(), 0.0);
+    assert_eq!(v["method"], "exact");
+}
+
+#[test]
+fn estimate_with_the_papers_aco_and_a_trace() {
+    let dir = tmp();
+    let file = simulate_open(dir.path(), "0.2");
+    let trace = dir.path().join("trace.csv");
+    let out = ok(&[
+        "estimate",
+        &file,
+        "--model",
+        "stenman",
+        "--method",
+        "aco",
+        "--seed",
+        "4",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--json",
+    ]);
+    let v = json(&out);
+    assert!((v["params"]["d"].as_f64().unwrap() - 0.2).abs() < 0.011);
+    assert_eq!(v["seed"], 4);
+    assert_eq!(v["certificate"]["estimate_is_optimal"], true);
+    let t = std::fs::read_to_string(trace).unwrap();
+    assert!(t.starts_with(
+        "iteration,best_d,best_sse,iteration_best_d,iteration_best_sse,evaluations\n"
+    ));
+    assert_eq!(t.lines().count(), 101);
+    // the same seed gives the same answer
+    assert_eq!(
+        json(&ok(&[
+            "estimate", &file, "--method", "aco", "--seed", "4", "--json"
+        ]))["params"],
+        v["params"]
+    );
+    // human output says the same in words
+    let human = ok(&["estimate", &file, "--method", "aco", "--seed", "4"]);
+    assert!(
+        human.contains("d = 0.2") && human.contains("is optimal"),
+        "{human}"
+    );
+}
+
+#[test]
+fn two_parameter_models_default_to_aco_r() {
+    let dir = tmp();
+    let file = dir.path().join("kano.csv");
+    let f = file.to_str().unwrap();
+    ok(&[
+        "simulate",
+        "--model",
+        "kano",
+        "--param",
+        "S=4,J=1",
+        "--signal",
+        "sine:amplitude=10,period=50,offset=50",
+        "--ts",
+        "0.5",
+        "--samples",
+        "600",
+        "-o",
+        f,
+    ]);
+    let v = json(&ok(&["estimate", f, "--model", "kano", "--json"]));
+    assert_eq!(v["method"], "aco-r");
+    assert!(
+        (v["params"]["S"].as_f64().unwrap() - 4.0).abs() < 0.3,
+        "{v}"
+    );
+    assert!(
+        (v["params"]["J"].as_f64().unwrap() - 1.0).abs() < 0.3,
+        "{v}"
+    );
+    let g = json(&ok(&[
+        "estimate", f, "--model", "he", "--method", "grid", "--points", "60", "--json",
+    ]));
+    assert_eq!(g["evaluations"], 3600);
+}
+
+#[test]
+fn closed_loop_simulation_as_in_the_issue() {
+    let dir = tmp();
+    let file = dir.path().join("loop.csv");
+    let f = file.to_str().unwrap();
+    ok(&[
+        "simulate",
+        "--loop",
+        "closed",
+        "--model",
+        "stenman",
+        "--param",
+        "d=0.5",
+        "--process",
+        "foptd:K=3,tau=10,delay=10",
+        "--pi",
+        "Kc=0.2,Ti=10",
+        "--ts",
+        "1",
+        "--samples",
+        "2000",
+        "--noise",
+        "0.05",
+        "--seed",
+        "7",
+        "-o",
+        f,
+    ]);
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.starts_with("t,sp,op,mv,pv\n"));
+    assert_eq!(text.lines().count(), 2001);
+    let row: Vec<&str> = text.lines().nth(1500).unwrap().split(',').collect();
+    assert_eq!(row.len(), 5);
+    assert!(row.iter().all(|c| c.parse::<f64>().is_ok()), "{row:?}");
+    // an ideal valve is a valid valve
+    ok(&[
+        "simulate", "--loop", "closed", "--model", "stenman", "--param", "d=0", "-o", f,
+    ]);
+    ok(&[
+        "simulate",
+        "--loop",
+        "closed",
+        "--model",
+        "kano",
+        "--param",
+        "S=3",
+        "--param",
+        "J=1",
+        "--process",
+        "integrating:K=0.02,delay=2",
+        "--pi",
+        "Kc=2,Ti=50",
+        "-o",
+        f,
+    ]);
+}
+
+#[test]
+fn columns_match_case_insensitively_and_separators_are_sniffed() {
+    let dir = tmp();
+    let mut text = String::from("Time;OP;Valve\n");
+    for k in 0..200 {
+        let u = (k as f64 * 0.3).sin() * 2.0;
+        let x = if k % 7 == 0 {
+            u
+        } else {
+            (u * 2.0).round() / 2.0
+        };
+        text.push_str(&format!("{k};{u};{x}\n"));
+    }
+    let f = write(dir.path(), "semi.csv", &text);
+    let v = json(&ok(&[
+        "estimate", &f, "--op", "op", "--mv", "VALVE", "--json",
+    ]));
+    assert_eq!(v["samples"], 200);
+    let tabbed = write(dir.path(), "tab.tsv", &text.replace(';', "\t"));
+    ok(&["estimate", &tabbed, "--mv", "valve", "--time", "TIME"]);
+}
+
+#[test]
+fn reproduce_paper_json_and_figures() {
+    let dir = tmp();
+    let out = dir.path().join("paper");
+    let v = json(&ok(&[
+        "reproduce",
+        "paper",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    let cases = v["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), 2);
+    for (c, (d, paper)) in cases.iter().zip([(0.2, 0.2), (0.5, 0.48)]) {
+        assert_eq!(c["true_d"], d);
+        assert_eq!(c["paper_estimate"], paper);
+        assert_eq!(c["estimates"].as_array().unwrap().len(), 20);
+        assert_eq!(c["inside"], 20);
+        let lo = c["interval"][0].as_f64().unwrap();
+        let hi = c["interval"][1].as_f64().unwrap();
+        assert!(lo <= d && d < hi);
+    }
+    for stem in [
+        "fig5_response_weak",
+        "fig6_response_strong",
+        "fig5-6_phase_plot",
+        "fig7_trajectories_weak",
+        "fig8_trajectories_strong",
+    ] {
+        for ext in ["png", "svg"] {
+            let p = out.join(format!("{stem}.{ext}"));
+            assert!(
+                std::fs::metadata(&p)
+                    .map(|m| m.len() > 5000)
+                    .unwrap_or(false),
+                "{}",
+                p.display()
+            );
+        }
+        let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).unwrap();
+        assert!(
+            svg.contains("<text"),
+            "{stem}.svg has no text (title, labels)"
+        );
+    }
+    let human = ok(&["reproduce", "paper", "--out", out.to_str().unwrap()]);
+    assert!(human.contains("20/20") && human.contains("0.48"), "{human}");
+}
+
+// ----------------------------------------------------------------------------- bad input
+
+fn good_rows(n: usize) -> String {
+    let mut s = String::from("t,op,mv\n");
+    for k in 0..n {
+        s.push_str(&format!("{k},{},{}\n", k % 5, (k % 5) / 2));
+    }
+    s
+}
+
+#[test]
+fn missing_file_and_column() {
+    let dir = tmp();
+    fails(
+        &["estimate", "/no/such/file.csv"],
+        &["/no/such/file.csv", "no such file"],
+    );
+    let f = write(dir.path(), "a.csv", &good_rows(20));
+    fails(
+        &["estimate", &f, "--mv", "position"],
+        &["a.csv", "'position'", "t, op, mv", "--mv"],
+    );
+    fails(
+        &["estimate", &f, "--time", "clock"],
+        &["a.csv", "'clock'", "--time"],
+    );
+}
+
+#[test]
+fn non_numeric_nan_and_infinite_cells() {
+    let dir = tmp();
+    let mut text = good_rows(20);
+    text = text.replacen("7,2,1", "7,abc,1", 1);
+    let f = write(dir.path(), "b.csv", &text);
+    fails(
+        &["estimate", &f],
+        &["b.csv", "line 9", "column 'op'", "'abc'", "not a number"],
+    );
+    let f = write(
+        dir.path(),
+        "c.csv",
+        &good_rows(20).replacen("7,2,1", "7,2,NaN", 1),
+    );
+    fails(
+        &["estimate", &f],
+        &["c.csv", "line 9", "column 'mv'", "finite"],
+    );
+    let f = write(
+        dir.path(),
+        "d.csv",
+        &good_rows(20).replacen("7,2,1", "7,inf,1", 1),
+    );
+    fails(
+        &["estimate", &f],
+        &["d.csv", "line 9", "column 'op'", "finite"],
+    );
+}
+
+#[test]
+fn too_few_samples_different_lengths_and_constant_command() {
+    let dir = tmp();
+    let f = write(dir.path(), "short.csv", &good_rows(6));
+    fails(&["estimate", &f], &["short.csv", "6 rows", "at least 10"]);
+    // mv stops early: the last rows have no mv
+    let mut text = good_rows(20);
+    for k in 20..25 {
+        text.push_str(&format!("{k},1,\n"));
+    }
+    let f = write(dir.path(), "ragged.csv", &text);
+    fails(
+        &["estimate", &f],
+        &[
+            "ragged.csv",
+            "column 'mv'",
+            "20 values",
+            "25 rows",
+            "different lengths",
+        ],
+    );
+    let mut text = String::from("t,op,mv\n");
+    for k in 0..30 {
+        text.push_str(&format!("{k},42,41\n"));
+    }
+    let f = write(dir.path(), "flat.csv", &text);
+    fails(&["estimate", &f], &["flat.csv", "column 'op'", "constant"]);
+    let f = write(
+        dir.path(),
+        "hole.csv",
+        &good_rows(20).replacen("7,2,1", "7,,1", 1),
+    );
+    fails(
+        &["estimate", &f],
+        &["hole.csv", "line 9", "column 'op'", "empty"],
+    );
+}
+
+#[test]
+fn bad_bounds_and_names() {
+    let dir = tmp();
+    let f = write(dir.path(), "e.csv", &good_rows(30));
+    fails(
+        &["estimate", &f, "--lo=-1", "--hi", "5"],
+        &["bounds for d", "negative"],
+    );
+    fails(
+        &["estimate", &f, "--lo", "5", "--hi", "1"],
+        &["bounds for d", "reversed"],
+    );
+    fails(
+        &["estimate", &f, "--bounds", "x=0:1"],
+        &["--bounds", "no parameter 'x'", "d"],
+    );
+    fails(
+        &["estimate", &f, "--model", "dahl"],
+        &["unknown model 'dahl'", "stenman, he, kano, choudhury"],
+    );
+    fails(
+        &["estimate", &f, "--method", "pso"],
+        &["unknown method 'pso'", "aco, aco-r, exact, grid"],
+    );
+    fails(
+        &["estimate", &f, "--model", "kano", "--method", "exact"],
+        &["exact", "Stenman model only"],
+    );
+    fails(
+        &[
+            "simulate", "--model", "kano", "--param", "S=2,d=1", "-o", "x.csv",
+        ],
+        &["unknown name 'd'", "S, J"],
+    );
+    fails(
+        &[
+            "simulate", "--model", "kano", "--param", "S=2", "-o", "x.csv",
+        ],
+        &["needs --param J"],
+    );
+    fails(
+        &[
+            "simulate",
+            "--model",
+            "he",
+            "--param",
+            "fs=1,fd=2",
+            "-o",
+            "x.csv",
+        ],
+        &["fd", "must not exceed"],
+    );
+    fails(
+        &["simulate", "--param", "d=-1", "-o", "x.csv"],
+        &["d = -1", ">= 0"],
+    );
+    fails(
+        &[
+            "simulate", "--param", "d=1", "--signal", "square", "-o", "x.csv",
+        ],
+        &["unknown signal 'square'"],
+    );
+    fails(
+        &[
+            "simulate",
+            "--loop",
+            "closed",
+            "--param",
+            "d=1",
+            "--process",
+            "foptd:tau=-3",
+            "-o",
+            "x.csv",
+        ],
+        &["tau", "> 0"],
+    );
+    fails(&["reproduce", "everything"], &["unknown target", "paper"]);
+}
