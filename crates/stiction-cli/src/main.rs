@@ -3,6 +3,7 @@
 //! JSON printer.
 
 mod cmd_estimate;
+mod cmd_quantify;
 mod cmd_reproduce;
 mod cmd_simulate;
 mod data;
@@ -32,6 +33,8 @@ enum Command {
     Simulate(cmd_simulate::Args),
     /// Estimate stiction-model parameters from the command (op) and the valve position (mv).
     Estimate(cmd_estimate::Args),
+    /// Quantify stiction from OP and PV alone (closed-loop Hammerstein identification).
+    Quantify(cmd_quantify::Args),
     /// Reproduce published results (`stiction reproduce paper`).
     Reproduce(cmd_reproduce::Args),
 }
@@ -41,6 +44,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(a) => cmd_simulate::run(a),
         Command::Estimate(a) => cmd_estimate::run(a),
+        Command::Quantify(a) => cmd_quantify::run(a),
         Command::Reproduce(a) => cmd_reproduce::run(a),
     };
     match result {

@@ -70,14 +70,43 @@ fn color(i: usize) -> RGBColor {
 
 /// Write `stem.png` and `stem.svg`; returns both paths.
 pub fn save(chart: &Chart, stem: &Path) -> Result<Vec<PathBuf>> {
+    save_panels(std::slice::from_ref(chart), stem)
+}
+
+/// Several charts stacked in one figure (shared page, each with its own axes).
+pub fn save_panels(charts: &[Chart], stem: &Path) -> Result<Vec<PathBuf>> {
     register_font();
+    if let Some(dir) = stem.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow!("{}: cannot create the folder: {e}", dir.display()))?;
+    }
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
-    let size = (1000, 600);
-    draw(BitMapBackend::new(&png, size).into_drawing_area(), chart)
-        .map_err(|e| anyhow!("{}: cannot draw the chart: {e}", png.display()))?;
-    draw(SVGBackend::new(&svg, size).into_drawing_area(), chart)
-        .map_err(|e| anyhow!("{}: cannot draw the chart: {e}", svg.display()))?;
+    let size = (1000, 600 * charts.len().max(1) as u32);
+    let bitmap = BitMapBackend::new(&png, size).into_drawing_area();
+    for (area, chart) in bitmap
+        .split_evenly((charts.len(), 1))
+        .into_iter()
+        .zip(charts)
+    {
+        draw(area, chart).map_err(|e| anyhow!("{}: cannot draw the chart: {e}", png.display()))?;
+    }
+    bitmap
+        .present()
+        .map_err(|e| anyhow!("{}: cannot write the chart: {e}", png.display()))?;
+    drop(bitmap);
+    let vector = SVGBackend::new(&svg, size).into_drawing_area();
+    for (area, chart) in vector
+        .split_evenly((charts.len(), 1))
+        .into_iter()
+        .zip(charts)
+    {
+        draw(area, chart).map_err(|e| anyhow!("{}: cannot draw the chart: {e}", svg.display()))?;
+    }
+    vector
+        .present()
+        .map_err(|e| anyhow!("{}: cannot write the chart: {e}", svg.display()))?;
+    drop(vector);
     Ok(vec![png, svg])
 }
 

@@ -4,7 +4,9 @@
 //! files, prints or plots. The command-line tool and every other front end share these results.
 
 pub mod estimate;
+pub mod identify;
 pub mod models;
+pub mod quantify;
 pub mod reproduce;
 pub mod rng;
 pub mod sim;

@@ -49,6 +49,8 @@ pub struct Acor {
     new: Vec<f64>,
     new_cost: Vec<f64>,
     order: Vec<usize>,
+    /// Known good solutions placed in the initial archive.
+    seeds: Vec<Vec<f64>>,
 }
 
 impl Acor {
@@ -73,11 +75,18 @@ impl Acor {
             new: vec![0.0; settings.ants * dim],
             new_cost: vec![0.0; settings.ants],
             order: Vec::new(),
+            seeds: Vec::new(),
             settings: AcorSettings {
                 archive: k,
                 ..settings
             },
         }
+    }
+
+    /// Start the archive from these solutions (and random ones for the rest).
+    pub fn with_seeds(mut self, seeds: Vec<Vec<f64>>) -> Self {
+        self.seeds = seeds;
+        self
     }
 
     fn reflect(&self, p: usize, mut v: f64) -> f64 {
@@ -121,7 +130,10 @@ impl Solver for Acor {
         let mut init = vec![0.0; k * dim];
         for i in 0..k {
             for (p, &(lo, hi)) in self.bounds.iter().enumerate() {
-                init[i * dim + p] = lo + (hi - lo) * rng.random::<f64>();
+                init[i * dim + p] = match self.seeds.get(i) {
+                    Some(seed) => seed[p].clamp(lo, hi),
+                    None => lo + (hi - lo) * rng.random::<f64>(),
+                };
             }
             self.kind.repair(&mut init[i * dim..(i + 1) * dim]);
         }

@@ -349,7 +349,7 @@ pub fn estimate(op: &[f64], mv: &[f64], req: &Request) -> Result<Estimate, Estim
         Method::Aco | Method::AcoR => {
             seed = Some(req.seed);
             let mut rng = seeded(req.seed);
-            let mut ev = solver::Evaluator::new(objective);
+            let mut ev = solver::Evaluator::new(&objective);
             let iters = if req.method == Method::Aco {
                 let mut s = aco::PaperAco::new(req.aco.clone(), req.model, &bounds);
                 trace = solver::run(&mut s, &mut ev, &mut rng, req.aco.iterations, req.trace);

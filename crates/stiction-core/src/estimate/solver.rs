@@ -3,20 +3,36 @@
 //! (one `next_iter` at a time), the executor ([`run`]: budget and seed) and observers (the
 //! per-iteration trace the paper plots).
 
-use super::objective::Objective;
 use crate::rng::Rng;
 use serde::{Deserialize, Serialize};
 
-/// Wraps the objective: solvers hand it whole populations, it counts and remembers the best.
+/// A cost to minimise over a box of parameters, evaluated a whole population at a time (the one
+/// place where batching and threads live).
+pub trait CostFunction: Sync {
+    fn dim(&self) -> usize;
+    /// Costs of `candidates` (flat, `dim` values each) into `costs`.
+    fn eval_batch(&self, candidates: &[f64], costs: &mut [f64]);
+}
+
+impl CostFunction for super::objective::Objective<'_> {
+    fn dim(&self) -> usize {
+        self.kind.dim()
+    }
+    fn eval_batch(&self, candidates: &[f64], costs: &mut [f64]) {
+        super::objective::Objective::eval_batch(self, candidates, costs)
+    }
+}
+
+/// Wraps the cost: solvers hand it whole populations, it counts and remembers the best.
 pub struct Evaluator<'a> {
-    objective: Objective<'a>,
+    objective: &'a dyn CostFunction,
     evaluations: u64,
     best: Vec<f64>,
     best_cost: f64,
 }
 
 impl<'a> Evaluator<'a> {
-    pub fn new(objective: Objective<'a>) -> Self {
+    pub fn new(objective: &'a dyn CostFunction) -> Self {
         Self {
             best: vec![f64::NAN; objective.dim()],
             objective,
@@ -27,10 +43,6 @@ impl<'a> Evaluator<'a> {
 
     pub fn dim(&self) -> usize {
         self.objective.dim()
-    }
-
-    pub fn objective(&self) -> &Objective<'a> {
-        &self.objective
     }
 
     /// Evaluate a population (flat, `dim` values per candidate) into `costs`.

@@ -1,0 +1,354 @@
+use crate::plot::{self, Chart, Kind, Series};
+use crate::{data, spec};
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use stiction_core::estimate::Method;
+use stiction_core::quantify::{quantify, Quantification, QuantifyRequest};
+
+#[derive(clap::Args)]
+#[command(after_help = "Examples:
+  stiction quantify loop.csv --op op --pv pv
+  stiction quantify loop.csv --model kano --method aco-r --seed 2 --json
+  stiction quantify CHEM1.csv --op OP --pv PV --ts 1 --plot out/chem1")]
+pub struct Args {
+    /// CSV file with a header line (comma, semicolon or tab separated)
+    file: PathBuf,
+    /// Column of the controller output
+    #[arg(long, default_value = "op")]
+    op: String,
+    /// Column of the process variable
+    #[arg(long, default_value = "pv")]
+    pv: String,
+    /// Column of time in seconds [default: the first of t, time, timestamp, if any]
+    #[arg(long)]
+    time: Option<String>,
+    /// Sampling time in seconds [default: from the time column, else 1]
+    #[arg(long)]
+    ts: Option<f64>,
+    /// Stiction model: stenman, he, kano, choudhury
+    #[arg(long, default_value = "stenman")]
+    model: String,
+    /// exact (stenman only), aco, aco-r, grid [default: exact for stenman, else aco-r]
+    #[arg(long)]
+    method: Option<String>,
+    /// Seed of the random methods
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Print one JSON object instead of text
+    #[arg(long)]
+    json: bool,
+    /// Write the PV-OP phase plot with the fitted model and the trends (PNG and SVG) to this folder
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// One parameter's search range, NAME=LO:HI (repeatable) [default: 0 to the OP's range]
+    #[arg(long = "bounds", value_name = "NAME=LO:HI")]
+    bounds: Vec<String>,
+    /// Largest process delay tried, in samples
+    #[arg(long, default_value_t = 30)]
+    max_delay: usize,
+    /// The process is integrating (a level loop); default: tried both ways
+    #[arg(long, conflicts_with = "self_regulating")]
+    integrating: bool,
+    /// The process is self-regulating; default: tried both ways
+    #[arg(long)]
+    self_regulating: bool,
+    /// exact: fit only the trajectories near the best points of a coarse scan (faster; exact there only)
+    #[arg(long)]
+    quick: bool,
+    /// aco, aco-r: ants per iteration
+    #[arg(long)]
+    ants: Option<usize>,
+    /// aco, aco-r: iterations
+    #[arg(long)]
+    iterations: Option<usize>,
+    /// grid: points per parameter
+    #[arg(long, default_value_t = 40)]
+    points: usize,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let kind = spec::model_kind(&a.model)?;
+    let method = match &a.method {
+        Some(m) => m
+            .parse::<Method>()
+            .map_err(|e| anyhow::anyhow!("--method: {e}"))?,
+        None => Method::default_for(kind),
+    };
+    if method == Method::Exact && kind != stiction_core::ModelKind::Stenman {
+        bail!("--method exact solves the Stenman model only; for {kind} use aco-r, aco or grid");
+    }
+    if let Some(ts) = a.ts {
+        if !(ts > 0.0 && ts.is_finite()) {
+            bail!("--ts {ts}: the sampling time must be a positive number of seconds");
+        }
+    }
+    let table = data::Table::read(&a.file)?;
+    let op_col = table.require(&a.op, "--op", "controller output op")?;
+    let pv_col = table.require(&a.pv, "--pv", "process variable pv")?;
+    let time_col = data::time_column(&table, a.time.as_deref())?;
+    let op = table.numbers(op_col)?;
+    let pv = table.numbers(pv_col)?;
+    let time = time_col.map(|c| table.numbers(c)).transpose()?;
+    let ts = match (a.ts, &time) {
+        (Some(ts), _) => ts,
+        (None, Some(t)) => sampling_time(t).with_context(|| {
+            format!(
+                "{}: the time column '{}' does not increase; give the sampling time with --ts SECONDS",
+                a.file.display(),
+                table.headers[time_col.unwrap_or(0)]
+            )
+        })?,
+        (None, None) => 1.0,
+    };
+
+    let mut req = QuantifyRequest::new(kind, method);
+    req.ts = ts;
+    req.seed = a.seed;
+    req.max_delay = a.max_delay;
+    req.full_partition = !a.quick;
+    req.integrating = if a.integrating {
+        Some(true)
+    } else if a.self_regulating {
+        Some(false)
+    } else {
+        None
+    };
+    req.grid.points = a.points;
+    if let Some(n) = a.ants {
+        req.aco.ants = n;
+        req.acor.ants = n;
+    }
+    if let Some(n) = a.iterations {
+        req.aco.iterations = n;
+        req.acor.iterations = n;
+    }
+    if !a.bounds.is_empty() {
+        let (lo, hi) = op
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                (l.min(v), h.max(v))
+            });
+        let mut b = vec![(0.0, (hi - lo).max(f64::MIN_POSITIVE)); kind.dim()];
+        for text in &a.bounds {
+            let parsed = text.split_once('=').and_then(|(n, r)| {
+                let (lo, hi) = r.split_once(':')?;
+                Some((
+                    n.trim(),
+                    lo.trim().parse::<f64>().ok()?,
+                    hi.trim().parse::<f64>().ok()?,
+                ))
+            });
+            let (name, lo, hi) = parsed.with_context(|| {
+                format!(
+                    "--bounds {text}: write NAME=LO:HI, e.g. --bounds {}=0:5",
+                    kind.param_names()[0]
+                )
+            })?;
+            let i = kind
+                .param_index(name)
+                .map_err(|e| anyhow::anyhow!("--bounds: {e}"))?;
+            b[i] = (lo, hi);
+        }
+        req.bounds = Some(b);
+    }
+    let q = quantify(&op, &pv, &req).map_err(|e| anyhow::anyhow!("{}: {e}", a.file.display()))?;
+
+    if let Some(dir) = &a.plot {
+        if q.status == "ok" {
+            let t: Vec<f64> = match &time {
+                Some(t) => t.clone(),
+                None => (0..op.len()).map(|k| k as f64 * ts).collect(),
+            };
+            plots(&q, &t, &op, &pv, dir)?;
+        }
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&q)?);
+        return Ok(());
+    }
+    if q.status != "ok" {
+        bail!(
+            "{}: insufficient data: {}",
+            a.file.display(),
+            q.reason.as_deref().unwrap_or("the loop cannot be judged")
+        );
+    }
+    print_human(&a.file.display().to_string(), &q, a.plot.as_deref());
+    Ok(())
+}
+
+/// The median step of a time column, if time increases.
+fn sampling_time(t: &[f64]) -> Option<f64> {
+    let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    if steps.is_empty() {
+        return None;
+    }
+    steps.sort_by(f64::total_cmp);
+    let ts = steps[steps.len() / 2];
+    (ts > 0.0 && ts.is_finite()).then_some(ts)
+}
+
+fn print_human(file: &str, q: &Quantification, plot_dir: Option<&Path>) {
+    let band = q.apparent_stiction.unwrap_or(f64::NAN);
+    let band_name = match q.model {
+        stiction_core::ModelKind::Stenman => "the Stenman band d",
+        stiction_core::ModelKind::He => "fs + fd",
+        _ => "S",
+    };
+    println!(
+        "{file}: apparent stiction {band:.3} (OP units, % of valve span when OP is in %; {band_name}), {:.1} % of the OP range",
+        q.apparent_stiction_pct_of_op_range.unwrap_or(f64::NAN)
+    );
+    println!("  this is an apparent stiction inferred from OP and PV without the valve position");
+    println!("  {} model, method {}:", q.model, q.method);
+    for spec in q.model.params() {
+        let v = q.params[spec.name];
+        print!("    {} = {v:.4} ({})", spec.name, spec.description);
+        if let Some([lo, hi]) = q.interval.get(spec.name) {
+            let what = match q.interval_kind.as_str() {
+                "exact" => "every value in",
+                "exact_local" => "every value in (exact near the best scan points)",
+                "grid" => "grid points at the minimum span",
+                _ => "fits equally well with the others fixed over",
+            };
+            print!("; {what} [{lo:.4}, {hi:.4}]");
+        }
+        println!();
+    }
+    if let Some(lm) = &q.linear_model {
+        let mut phys = Vec::new();
+        if let Some(g) = lm.gain {
+            phys.push(if lm.family == "integrating" {
+                format!("integration rate {g:.4} per s")
+            } else {
+                format!("gain {g:.3}")
+            });
+        }
+        if let Some(tc) = lm.time_constant {
+            phys.push(format!("time constant {tc:.1} s"));
+        }
+        phys.push(format!("dead time {:.1} s", lm.dead_time));
+        println!(
+            "  linear model: {} ARX, na = {}, nb = {}, delay {} samples: {}",
+            lm.family.replace('_', "-"),
+            lm.na,
+            lm.nb,
+            lm.nk,
+            phys.join(", ")
+        );
+    }
+    if let Some(f) = &q.fit {
+        println!(
+            "  fit of {}: R² {:.4} in simulation, {:.4} one step ahead",
+            if f.output == "pv" {
+                "PV"
+            } else {
+                "the PV's change per sample"
+            },
+            f.r2_simulation,
+            f.r2_one_step
+        );
+    }
+    let cells = q
+        .cells
+        .map(|c| format!(", {c} valve trajectories"))
+        .unwrap_or_default();
+    println!(
+        "  {} samples at {} s, {} evaluations{cells}, {:.1} ms",
+        q.samples,
+        q.ts,
+        q.evaluations,
+        q.seconds * 1e3
+    );
+    for w in &q.warnings {
+        println!("  warning: {w}");
+    }
+    if let Some(d) = plot_dir {
+        println!("  plots in {}", d.display());
+    }
+}
+
+fn plots(q: &Quantification, t: &[f64], op: &[f64], pv: &[f64], dir: &Path) -> Result<()> {
+    let phase = Chart {
+        title: format!(
+            "PV against OP, with the fitted {} model (apparent stiction {:.3})",
+            q.model,
+            q.apparent_stiction.unwrap_or(f64::NAN)
+        ),
+        x_label: "controller output OP (%)".into(),
+        y_label: "process variable PV".into(),
+        series: vec![
+            Series {
+                label: "measured".into(),
+                x: op,
+                y: pv,
+                kind: Kind::Line,
+                color: 5,
+                thin: true,
+            },
+            Series {
+                label: "fitted model, simulated".into(),
+                x: op,
+                y: &q.pv_simulated,
+                kind: Kind::Line,
+                color: 1,
+                thin: false,
+            },
+        ],
+        bands: vec![],
+        y_range: None,
+    };
+    plot::save(&phase, &dir.join("phase_plot"))?;
+    let valve = Chart {
+        title: "Controller output and the estimated valve position".into(),
+        x_label: "time (s)".into(),
+        y_label: "% of valve span".into(),
+        series: vec![
+            Series {
+                label: "OP".into(),
+                x: t,
+                y: op,
+                kind: Kind::Line,
+                color: 0,
+                thin: false,
+            },
+            Series {
+                label: "estimated MV".into(),
+                x: t,
+                y: &q.mv,
+                kind: Kind::Step,
+                color: 1,
+                thin: false,
+            },
+        ],
+        bands: vec![],
+        y_range: None,
+    };
+    let process = Chart {
+        title: "Process variable: measured and simulated by the fitted model".into(),
+        x_label: "time (s)".into(),
+        y_label: "PV".into(),
+        series: vec![
+            Series {
+                label: "PV measured".into(),
+                x: t,
+                y: pv,
+                kind: Kind::Line,
+                color: 5,
+                thin: false,
+            },
+            Series {
+                label: "PV simulated".into(),
+                x: t,
+                y: &q.pv_simulated,
+                kind: Kind::Line,
+                color: 2,
+                thin: false,
+            },
+        ],
+        bands: vec![],
+        y_range: None,
+    };
+    plot::save_panels(&[valve, process], &dir.join("trends"))?;
+    Ok(())
+}

@@ -1,0 +1,867 @@
+//! Quantifying stiction from OP and PV alone: closed-loop Hammerstein identification.
+//!
+//!   mv = stiction_θ(op)                         (the valve position is not measured)
+//!   A(q) y[t] = B(q) mv[t - nk] + c             (y = pv, or its change for integrating processes)
+//!
+//! Separable: for fixed stiction parameters θ the valve position is simulated from OP and the
+//! linear part fitted by least squares; the outer search over θ ranks candidates by how well the
+//! fitted model *simulates* the PV (output error), which one-step prediction alone does not
+//! discriminate. For Stenman the outer search is exact: the d-range is partitioned into cells with
+//! identical valve trajectories and every cell is fitted once. Orders and delay are chosen by BIC.
+//!
+//! The answer is an *apparent* stiction: inferred without the valve position, from data that an
+//! oscillating loop may not make fully identifiable.
+
+use crate::estimate::solver::{self, CostFunction, Evaluator};
+use crate::estimate::{
+    aco, acor, exact, AcoSettings, AcorSettings, EstimateError, GridSettings, Method,
+};
+use crate::identify::{self, Data, Fit, SearchRange, Structure};
+use crate::models::ModelKind;
+use crate::rng::seeded;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct QuantifyRequest {
+    pub model: ModelKind,
+    pub method: Method,
+    /// Sampling time in seconds (for the time constant and dead time).
+    pub ts: f64,
+    /// Search range per stiction parameter; `None`: 0 up to the OP's peak-to-peak range.
+    pub bounds: Option<Vec<(f64, f64)>>,
+    pub seed: u64,
+    pub aco: AcoSettings,
+    pub acor: AcorSettings,
+    pub grid: GridSettings,
+    /// Largest delay tried, in samples.
+    pub max_delay: usize,
+    /// `Some(true)`: integrating process only; `Some(false)`: self-regulating only; `None`: both.
+    pub integrating: Option<bool>,
+    /// Stenman exact: fit every cell of the whole d-range, not only those around the best scan points.
+    pub full_partition: bool,
+}
+
+impl QuantifyRequest {
+    pub fn new(model: ModelKind, method: Method) -> Self {
+        let grid = GridSettings { points: 40 };
+        Self {
+            model,
+            method,
+            ts: 1.0,
+            bounds: None,
+            seed: 1,
+            aco: AcoSettings::default(),
+            acor: AcorSettings {
+                iterations: 60,
+                ..AcorSettings::default()
+            },
+            grid,
+            max_delay: 30,
+            integrating: None,
+            full_partition: true,
+        }
+    }
+}
+
+/// The identified linear part.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LinearModel {
+    /// "self_regulating" (output pv) or "integrating" (output: the change of pv per sample).
+    pub family: String,
+    pub na: usize,
+    pub nb: usize,
+    /// Delay in samples from valve position to output (1 = the next sample).
+    pub nk: usize,
+    /// y[t] = sum a_i y[t-i] + sum b_j mv[t-nk-j] + c, y and mv centred.
+    pub a: Vec<f64>,
+    pub b: Vec<f64>,
+    pub c: f64,
+    pub gain: Option<f64>,
+    /// Seconds.
+    pub time_constant: Option<f64>,
+    /// Seconds.
+    pub dead_time: f64,
+    /// The criterion the orders and delay were chosen by.
+    pub criterion: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitQuality {
+    /// The output the R² refer to: "pv" or "delta_pv".
+    pub output: String,
+    pub r2_simulation: f64,
+    pub r2_one_step: f64,
+    pub sse_simulation: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Quantification {
+    /// "ok" or "insufficient_data".
+    pub status: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    pub model: ModelKind,
+    pub method: Method,
+    pub params: BTreeMap<String, f64>,
+    /// Per parameter, the values that fit equally well: exact for Stenman with `exact` (the cells of
+    /// least simulation error); for other methods, along each axis with the others held at the
+    /// estimate.
+    pub interval: BTreeMap<String, [f64; 2]>,
+    pub interval_kind: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub linear_model: Option<LinearModel>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fit: Option<FitQuality>,
+    /// The stiction band in OP units (% of valve span when OP is in %): Stenman d; He fs + fd;
+    /// Kano and Choudhury S.
+    pub apparent_stiction: Option<f64>,
+    /// The same band as a percentage of the OP's peak-to-peak range in the data.
+    pub apparent_stiction_pct_of_op_range: Option<f64>,
+    pub op_range: f64,
+    pub evaluations: u64,
+    /// Stenman with `exact`: the number of distinct valve trajectories.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cells: Option<usize>,
+    pub seconds: f64,
+    pub samples: usize,
+    pub ts: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    pub warnings: Vec<String>,
+    pub caveat: String,
+    /// The estimated valve position (not serialised: for plots).
+    #[serde(skip)]
+    pub mv: Vec<f64>,
+    /// The fitted model's simulated PV (not serialised: for plots).
+    #[serde(skip)]
+    pub pv_simulated: Vec<f64>,
+}
+
+const CAVEAT: &str = "apparent stiction inferred from OP and PV without the valve position; \
+oscillating closed-loop data may not identify the valve and the process separately";
+
+impl Quantification {
+    fn insufficient(req: &QuantifyRequest, n: usize, op_range: f64, reason: String) -> Self {
+        Self {
+            status: "insufficient_data".into(),
+            reason: Some(reason),
+            model: req.model,
+            method: req.method,
+            params: BTreeMap::new(),
+            interval: BTreeMap::new(),
+            interval_kind: "none".into(),
+            linear_model: None,
+            fit: None,
+            apparent_stiction: None,
+            apparent_stiction_pct_of_op_range: None,
+            op_range,
+            evaluations: 0,
+            cells: None,
+            seconds: 0.0,
+            samples: n,
+            ts: req.ts,
+            seed: None,
+            warnings: Vec::new(),
+            caveat: CAVEAT.into(),
+            mv: Vec::new(),
+            pv_simulated: Vec::new(),
+        }
+    }
+}
+
+fn range(v: &[f64]) -> (f64, f64) {
+    v.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        })
+}
+
+/// The closed-loop objective: simulation error of the least-squares linear fit for the valve
+/// trajectory of each candidate.
+struct Hammerstein<'a> {
+    kind: ModelKind,
+    op: &'a [f64],
+    prepared: identify::Prepared<'a>,
+    /// Subtracted from the valve position (the mean OP) to keep the normal equations well scaled.
+    offset: f64,
+}
+
+impl<'a> Hammerstein<'a> {
+    fn new(kind: ModelKind, op: &'a [f64], data: &'a Data<'a>, structure: Structure) -> Self {
+        Self {
+            kind,
+            op,
+            prepared: identify::Prepared::new(data, structure),
+            offset: op.iter().sum::<f64>() / op.len() as f64,
+        }
+    }
+
+    fn valve_into(&self, theta: &[f64], mv: &mut [f64]) {
+        let model = self.kind.build(theta).expect("candidates are repaired");
+        model.simulate_into(self.op, mv);
+        for v in mv.iter_mut() {
+            *v -= self.offset;
+        }
+    }
+
+    fn valve(&self, theta: &[f64]) -> Vec<f64> {
+        let mut mv = vec![0.0; self.op.len()];
+        self.valve_into(theta, &mut mv);
+        mv
+    }
+
+    fn fit(&self, theta: &[f64]) -> Option<Fit> {
+        self.prepared.fit(&self.valve(theta))
+    }
+
+    /// The cost of one candidate, with a caller's buffer for the valve position.
+    fn cost_with(&self, theta: &[f64], mv: &mut [f64]) -> f64 {
+        self.valve_into(theta, mv);
+        self.prepared
+            .fit(mv)
+            .map_or(f64::INFINITY, |f| f.sse_simulation)
+    }
+
+    fn cost(&self, theta: &[f64]) -> f64 {
+        self.cost_with(theta, &mut vec![0.0; self.op.len()])
+    }
+
+    /// Costs of many one-parameter candidates, in parallel, one buffer per thread.
+    fn costs_1d(&self, values: &[f64]) -> Vec<f64> {
+        let n = self.op.len();
+        let mut out = vec![0.0; values.len()];
+        out.par_iter_mut()
+            .zip(values.par_iter())
+            .with_min_len(8)
+            .for_each_init(
+                || vec![0.0; n],
+                |buf, (c, &v)| *c = self.cost_with(&[v], buf),
+            );
+        out
+    }
+}
+
+impl CostFunction for Hammerstein<'_> {
+    fn dim(&self) -> usize {
+        self.kind.dim()
+    }
+    fn eval_batch(&self, candidates: &[f64], costs: &mut [f64]) {
+        let dim = self.dim();
+        let n = self.op.len();
+        costs
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(4)
+            .for_each_init(
+                || vec![0.0; n],
+                |buf, (i, c)| *c = self.cost_with(&candidates[i * dim..(i + 1) * dim], buf),
+            );
+    }
+}
+
+/// Quantify stiction from OP and PV. Data that cannot be judged gives `status: insufficient_data`
+/// with the reason; requests that are wrong (bounds, settings) give an error.
+pub fn quantify(
+    op: &[f64],
+    pv: &[f64],
+    req: &QuantifyRequest,
+) -> Result<Quantification, EstimateError> {
+    let started = Instant::now();
+    let n = op.len();
+    if pv.len() != n {
+        return Err(EstimateError::Data(format!(
+            "op has {n} samples but pv has {}",
+            pv.len()
+        )));
+    }
+    for (name, s) in [("op", op), ("pv", pv)] {
+        if let Some(i) = s.iter().position(|v| !v.is_finite()) {
+            return Err(EstimateError::Data(format!(
+                "{name} sample {i} is {}; every value must be a finite number",
+                s[i]
+            )));
+        }
+    }
+    if !(req.ts > 0.0 && req.ts.is_finite()) {
+        return Err(EstimateError::Settings(format!(
+            "the sampling time must be a positive number of seconds, got {}",
+            req.ts
+        )));
+    }
+    if req.method == Method::Exact && req.model != ModelKind::Stenman {
+        return Err(EstimateError::ExactNeedsStenman(req.model));
+    }
+    let (op_lo, op_hi) = range(op);
+    let (pv_lo, pv_hi) = range(pv);
+    let op_range = if n > 0 { op_hi - op_lo } else { 0.0 };
+    let mut search = SearchRange::new(req.max_delay.min(n / 20).max(1));
+    if let Some(integrating) = req.integrating {
+        search.integrating = integrating;
+        search.self_regulating = !integrating;
+    }
+    let needed = search.t0() + 20 * (search.na.len() + search.nb_max + 1);
+    let insufficient =
+        |why: String| Ok(Quantification::insufficient(req, n, op_range.max(0.0), why));
+    if n < needed {
+        return insufficient(format!(
+            "only {n} samples; the linear model search (delays up to {} samples) needs at least {needed}",
+            search.nk_max
+        ));
+    }
+    if op_range <= 0.0 {
+        return insufficient(format!(
+            "OP is constant at {op_lo}: the valve is never moved"
+        ));
+    }
+    if pv_hi - pv_lo <= 0.0 {
+        return insufficient(format!(
+            "PV is constant at {pv_lo}: nothing responds to the valve"
+        ));
+    }
+    let saturated = op.iter().filter(|&&v| v <= 0.0 || v >= 100.0).count();
+    if saturated == n {
+        return insufficient("OP is saturated (at or beyond 0 or 100 %) the whole time".into());
+    }
+
+    let bounds: Vec<(f64, f64)> = match &req.bounds {
+        Some(b) => b.clone(),
+        None => vec![(0.0, op_range); req.model.dim()],
+    };
+    if bounds.len() != req.model.dim() {
+        return Err(EstimateError::Settings(format!(
+            "model {} has {} parameters but {} bounds were given",
+            req.model,
+            req.model.dim(),
+            bounds.len()
+        )));
+    }
+    for (spec, &(lo, hi)) in req.model.params().iter().zip(&bounds) {
+        let err = |why| EstimateError::Bounds {
+            name: spec.name.into(),
+            lo,
+            hi,
+            why,
+        };
+        if !lo.is_finite() || !hi.is_finite() {
+            return Err(err("both ends must be finite numbers"));
+        }
+        if lo < 0.0 {
+            return Err(err("the lower end must not be negative"));
+        }
+        if lo >= hi {
+            return Err(err(
+                "the lower end must be below the upper end (reversed or empty)",
+            ));
+        }
+    }
+
+    let data = Data::new(pv, search.t0());
+    let mut evaluations = 0u64;
+    // pilot: the process family and a first structure, chosen at a spread of stiction parameters
+    let pilots = pilot_points(req.model, &bounds);
+    let choices: Vec<identify::Selection> = pilots
+        .par_iter()
+        .filter_map(|theta| {
+            let model = req.model.build(theta).ok()?;
+            identify::select(&data, &identify::centred(&model.simulate(op)), &search)
+        })
+        .collect();
+    evaluations += pilots.len() as u64;
+    // the distinct structures the pilots chose, best one-step fit first: the first few are searched
+    let mut ranked: Vec<identify::Selection> = choices.clone();
+    ranked.sort_by(|a, b| a.one_step_bic.total_cmp(&b.one_step_bic));
+    let mut queue: std::collections::VecDeque<Structure> = Default::default();
+    // two-parameter models start from the Stenman answer (structure and band), which the exact
+    // search finds reliably
+    let mut stenman_d = None;
+    if req.model.dim() == 2 {
+        let mut sreq = QuantifyRequest::new(ModelKind::Stenman, Method::Exact);
+        sreq.ts = req.ts;
+        sreq.max_delay = req.max_delay;
+        sreq.integrating = req.integrating;
+        sreq.bounds = Some(vec![(bounds[0].0, bounds[0].1.max(bounds[1].1))]);
+        let sq = quantify(op, pv, &sreq)?;
+        evaluations += sq.evaluations;
+        if let (Some(lm), Some(d)) = (&sq.linear_model, sq.params.get("d")) {
+            queue.push_back(Structure {
+                integrating: lm.family == "integrating",
+                na: lm.na,
+                nb: lm.nb,
+                nk: lm.nk,
+            });
+            stenman_d = Some(*d);
+        }
+    }
+    for c in &ranked {
+        if !queue.contains(&c.structure) && queue.len() < STARTING_STRUCTURES {
+            queue.push_back(c.structure);
+        }
+    }
+    if queue.is_empty() {
+        return insufficient(
+            "no linear model could be fitted: the valve trajectory never excites the PV".into(),
+        );
+    }
+
+    // search the stiction parameters for each structure; confirm the structure at each answer and
+    // search again with a new one if it differs; keep the answer whose simulation BIC is least
+    let mut seed = None;
+    let mut tried: Vec<(Structure, Outcome, f64)> = Vec::new();
+    while let Some(structure) = queue.pop_front() {
+        if tried.iter().any(|t| t.0 == structure) || tried.len() >= MOST_STRUCTURES {
+            continue;
+        }
+        let problem = Hammerstein::new(req.model, op, &data, structure);
+        let outcome = match req.method {
+            Method::Exact => exact_stenman(&problem, bounds[0], req.full_partition),
+            Method::Grid => grid_search(&problem, &bounds, &req.grid),
+            Method::Aco | Method::AcoR => {
+                seed = Some(req.seed);
+                let mut rng = seeded(req.seed);
+                let mut ev = Evaluator::new(&problem);
+                // the Stenman band is a good first guess for the two-parameter models: Kano and
+                // Choudhury with J = S, He with fd = 0 behave alike
+                let stenman_evals = 0;
+                if req.method == Method::Aco {
+                    let mut s = aco::PaperAco::new(req.aco.clone(), req.model, &bounds);
+                    solver::run(&mut s, &mut ev, &mut rng, req.aco.iterations, false);
+                } else {
+                    let seeds = stenman_d
+                        .map(|d| first_guesses(req.model, d))
+                        .unwrap_or_default();
+                    let mut s =
+                        acor::Acor::new(req.acor.clone(), req.model, &bounds).with_seeds(seeds);
+                    solver::run(&mut s, &mut ev, &mut rng, req.acor.iterations, false);
+                }
+                let (best, cost, polish_evals) =
+                    polish(&problem, ev.best(), ev.best_cost(), &bounds);
+                let (interval, extra) = axis_intervals(&problem, &best, &bounds, cost);
+                Outcome {
+                    best,
+                    interval,
+                    interval_kind: "axis",
+                    evaluations: ev.evaluations() + extra + stenman_evals + polish_evals,
+                    cells: None,
+                }
+            }
+        };
+        evaluations += outcome.evaluations;
+        let criterion = problem
+            .fit(&outcome.best)
+            .map_or(f64::INFINITY, |f| identify::simulation_bic(&data, &f));
+        let mv_c = problem.valve(&outcome.best);
+        tried.push((structure, outcome, criterion));
+        evaluations += 1;
+        if let Some(next) = identify::select(&data, &mv_c, &search) {
+            if !tried.iter().any(|t| t.0 == next.structure) {
+                queue.push_front(next.structure);
+            }
+        }
+    }
+    let (structure, outcome, _) = tried
+        .into_iter()
+        .min_by(|a, b| a.2.total_cmp(&b.2))
+        .expect("at least one search ran");
+
+    let problem = Hammerstein::new(req.model, op, &data, structure);
+    let Some(fit) = problem.fit(&outcome.best) else {
+        return insufficient("the best valve trajectory leaves the linear fit singular".into());
+    };
+    if !fit.sse_simulation.is_finite() {
+        return insufficient("no candidate gives a stable simulation of the PV".into());
+    }
+    let model = req.model.build(&outcome.best).expect("repaired");
+    let mv = model.simulate(op);
+    let pv_simulated = identify::simulate_pv(&data, &problem.valve(&outcome.best), &fit);
+    let phys = identify::physical(&fit, req.ts);
+    let names = req.model.param_names();
+    let band = match req.model {
+        ModelKind::Stenman => outcome.best[0],
+        ModelKind::He => outcome.best[0] + outcome.best[1],
+        ModelKind::Kano | ModelKind::Choudhury => outcome.best[0],
+    };
+    let mut warnings = Vec::new();
+    if fit.r2_simulation() < 0.5 {
+        warnings.push(format!(
+            "the simulated PV explains only {:.0} % of its variance: the stiction model and a linear process \
+             do not describe this loop well; treat the estimate with care",
+            100.0 * fit.r2_simulation().max(0.0)
+        ));
+    }
+    for (p, &(lo, hi)) in bounds.iter().enumerate() {
+        if let Some([a, b]) = outcome.interval.get(names[p]) {
+            if *b >= hi && outcome.best[p] > lo + 0.5 * (hi - lo) {
+                warnings.push(format!(
+                    "{} reaches the top of its search range [{lo}, {hi}] ({a:.4} to {b:.4} fit equally): widen --bounds",
+                    names[p]
+                ));
+            }
+        }
+    }
+    let moves = mv.windows(2).filter(|w| w[1] != w[0]).count();
+    if moves < 4 {
+        warnings.push(format!(
+            "the estimated valve moves only {moves} times: too few to identify the process"
+        ));
+    }
+    let s = fit.structure;
+    Ok(Quantification {
+        status: "ok".into(),
+        reason: None,
+        model: req.model,
+        method: req.method,
+        params: names
+            .iter()
+            .zip(&outcome.best)
+            .map(|(n, &v)| (n.to_string(), v))
+            .collect(),
+        interval: outcome.interval,
+        interval_kind: outcome.interval_kind.into(),
+        linear_model: Some(LinearModel {
+            family: if s.integrating {
+                "integrating"
+            } else {
+                "self_regulating"
+            }
+            .into(),
+            na: s.na,
+            nb: s.nb,
+            nk: s.nk,
+            a: fit.a.clone(),
+            b: fit.b.clone(),
+            c: fit.c,
+            gain: phys.gain,
+            time_constant: phys.time_constant,
+            dead_time: phys.dead_time,
+            criterion: format!(
+                "BIC of one-step prediction over na in {:?}, nb 1..={}, delay 1..={} samples, {}",
+                search.na,
+                search.nb_max,
+                search.nk_max,
+                match (search.self_regulating, search.integrating) {
+                    (true, true) => "self-regulating and integrating",
+                    (true, false) => "self-regulating",
+                    _ => "integrating",
+                }
+            ),
+        }),
+        fit: Some(FitQuality {
+            output: if s.integrating { "delta_pv" } else { "pv" }.into(),
+            r2_simulation: fit.r2_simulation(),
+            r2_one_step: fit.r2_one_step(),
+            sse_simulation: fit.sse_simulation,
+        }),
+        apparent_stiction: Some(band),
+        apparent_stiction_pct_of_op_range: Some(100.0 * band / op_range),
+        op_range,
+        evaluations,
+        cells: outcome.cells,
+        seconds: started.elapsed().as_secs_f64(),
+        samples: n,
+        ts: req.ts,
+        seed,
+        warnings,
+        caveat: CAVEAT.into(),
+        mv,
+        pv_simulated,
+    })
+}
+
+/// Starting points for a two-parameter search from the Stenman band d.
+fn first_guesses(kind: ModelKind, d: f64) -> Vec<Vec<f64>> {
+    let mut out = match kind {
+        ModelKind::He => vec![
+            vec![d, 0.0],
+            vec![d, 0.25 * d],
+            vec![d, 0.5 * d],
+            vec![1.5 * d, 0.5 * d],
+        ],
+        _ => vec![
+            vec![d, d],
+            vec![d, 0.5 * d],
+            vec![d, 0.25 * d],
+            vec![1.5 * d, 0.5 * d],
+            vec![1.5 * d, d],
+            vec![2.0 * d, d],
+            vec![0.75 * d, 0.75 * d],
+        ],
+    };
+    for g in &mut out {
+        kind.repair(g);
+    }
+    out
+}
+
+/// Polish a two-parameter answer by coordinate scans: each parameter in turn over a fine grid
+/// around its value (the objective is a step function, so gradients cannot do this), narrowing
+/// three times.
+fn polish(
+    problem: &Hammerstein,
+    start: &[f64],
+    cost: f64,
+    bounds: &[(f64, f64)],
+) -> (Vec<f64>, f64, u64) {
+    const POINTS: usize = 161;
+    let mut best = start.to_vec();
+    let mut best_cost = cost;
+    let mut evals = 0u64;
+    let dim = best.len();
+    for round in 0..3 {
+        for p in 0..dim {
+            let (lo, hi) = bounds[p];
+            let width = 0.5f64.powi(round) * 0.5 * best[p].abs().max(0.05 * (hi - lo));
+            let (a, b) = ((best[p] - width).max(lo), (best[p] + width).min(hi));
+            let mut cands = Vec::with_capacity(POINTS * dim);
+            for i in 0..POINTS {
+                let mut theta = best.clone();
+                theta[p] = a + (b - a) * i as f64 / (POINTS - 1) as f64;
+                problem.kind.repair(&mut theta);
+                cands.extend_from_slice(&theta);
+            }
+            let mut costs = vec![0.0; POINTS];
+            problem.eval_batch(&cands, &mut costs);
+            evals += POINTS as u64;
+            for (i, &c) in costs.iter().enumerate() {
+                if c < best_cost {
+                    best_cost = c;
+                    best.copy_from_slice(&cands[i * dim..(i + 1) * dim]);
+                }
+            }
+        }
+    }
+    (best, best_cost, evals)
+}
+
+/// Structures from the pilots that are searched first, and the most searched in all.
+const STARTING_STRUCTURES: usize = 3;
+const MOST_STRUCTURES: usize = 5;
+
+struct Outcome {
+    best: Vec<f64>,
+    interval: BTreeMap<String, [f64; 2]>,
+    interval_kind: &'static str,
+    evaluations: u64,
+    cells: Option<usize>,
+}
+
+/// Parameter sets at which the linear structure is chosen before the main search.
+fn pilot_points(kind: ModelKind, bounds: &[(f64, f64)]) -> Vec<Vec<f64>> {
+    // geometric spread: stiction bands are usually a small share of the OP range
+    let axis = |(lo, hi): (f64, f64), k: usize| -> Vec<f64> {
+        let first = (hi - lo) * 0.005;
+        (0..k)
+            .map(|i| lo + first * ((hi - lo) / first).powf(i as f64 / (k - 1) as f64))
+            .collect()
+    };
+    if kind.dim() == 1 {
+        let (lo, hi) = bounds[0];
+        let mut v: Vec<Vec<f64>> = axis(bounds[0], 24).into_iter().map(|d| vec![d]).collect();
+        v.extend((0..8).map(|i| vec![lo + (hi - lo) * (i as f64 + 0.5) / 8.0]));
+        v.push(vec![lo]);
+        v
+    } else {
+        let mut out = Vec::new();
+        for a in axis(bounds[0], 5) {
+            for b in axis(bounds[1], 4) {
+                let mut p = vec![a, b];
+                kind.repair(&mut p);
+                out.push(p);
+            }
+        }
+        out
+    }
+}
+
+/// Stenman, exact: every distinct valve trajectory (cell of the partition of the d-range) is
+/// fitted once. The range is cut into fixed chunks walked in parallel, so the work spreads over
+/// threads and the result does not depend on their number. Without `full`, only the chunks around
+/// the best points of a coarse scan are walked (faster, exact only there).
+fn exact_stenman(problem: &Hammerstein, (lo, hi): (f64, f64), full: bool) -> Outcome {
+    const CHUNKS: usize = 64;
+    let first = (hi - lo) * 1e-4;
+    let mut edges: Vec<f64> = (0..CHUNKS)
+        .map(|i| lo + first * ((hi - lo) / first).powf(i as f64 / (CHUNKS - 1) as f64))
+        .collect();
+    edges[0] = lo;
+    edges.push(hi);
+    edges.dedup();
+    let mut chunks: Vec<(f64, f64)> = edges.windows(2).map(|w| (w[0], w[1])).collect();
+    if !full {
+        let mids: Vec<f64> = chunks.iter().map(|c| 0.5 * (c.0 + c.1)).collect();
+        let costs = problem.costs_1d(&mids);
+        let mut order: Vec<usize> = (0..chunks.len()).collect();
+        order.sort_by(|&i, &j| costs[i].total_cmp(&costs[j]));
+        let keep: Vec<usize> = order
+            .iter()
+            .take(3)
+            .flat_map(|&i| [i.saturating_sub(1), i, (i + 1).min(chunks.len() - 1)])
+            .collect();
+        chunks = chunks
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| keep.contains(i))
+            .map(|(_, &c)| c)
+            .collect();
+    }
+    let n = problem.op.len();
+    let per_chunk: Vec<Vec<((f64, f64), f64)>> = chunks
+        .par_iter()
+        .map_init(
+            || vec![0.0; n],
+            |mv, &chunk| {
+                let mut out = Vec::new();
+                exact::stenman_walk(problem.op, chunk, (lo, hi), mv, |cell, mv| {
+                    for v in mv.iter_mut() {
+                        *v -= problem.offset;
+                    }
+                    let cost = problem
+                        .prepared
+                        .fit(mv)
+                        .map_or(f64::INFINITY, |f| f.sse_simulation);
+                    out.push((cell, cost));
+                });
+                out
+            },
+        )
+        .collect();
+    let cells: Vec<((f64, f64), f64)> = per_chunk.into_iter().flatten().collect();
+    let best = cells.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+    let mut optimal: Vec<(f64, f64)> = Vec::new();
+    for &(cell, cost) in &cells {
+        if cost == best {
+            match optimal.last_mut() {
+                // pieces of one cell split at a chunk edge join again
+                Some(last) if last.1 >= cell.0 => last.1 = last.1.max(cell.1),
+                _ => optimal.push(cell),
+            }
+        }
+    }
+    // the widest optimal piece's midpoint is the point estimate; the interval is their hull
+    let (a, b) = optimal
+        .iter()
+        .copied()
+        .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+        .unwrap_or((lo, hi));
+    let hull = [
+        optimal.first().map_or(lo, |c| c.0),
+        optimal.last().map_or(hi, |c| c.1),
+    ];
+    Outcome {
+        best: vec![0.5 * (a + b)],
+        interval: BTreeMap::from([("d".to_string(), hull)]),
+        interval_kind: if full { "exact" } else { "exact_local" },
+        evaluations: cells.len() as u64,
+        cells: Some(cells.len()),
+    }
+}
+
+fn grid_search(problem: &Hammerstein, bounds: &[(f64, f64)], settings: &GridSettings) -> Outcome {
+    let dim = bounds.len();
+    let per = settings.points.max(2);
+    let axes: Vec<Vec<f64>> = bounds
+        .iter()
+        .map(|&(lo, hi)| {
+            (0..per)
+                .map(|i| lo + (hi - lo) * i as f64 / (per - 1) as f64)
+                .collect()
+        })
+        .collect();
+    let total = per.pow(dim as u32);
+    let mut cands = Vec::with_capacity(total * dim);
+    for i in 0..total {
+        let start = cands.len();
+        let mut rest = i;
+        for axis in axes.iter().rev() {
+            cands.push(axis[rest % per]);
+            rest /= per;
+        }
+        cands[start..].reverse();
+        problem.kind.repair(&mut cands[start..]);
+    }
+    let mut costs = vec![0.0; total];
+    problem.eval_batch(&cands, &mut costs);
+    let best_i = (0..total).fold(0, |m, i| if costs[i] < costs[m] { i } else { m });
+    let best = cands[best_i * dim..(best_i + 1) * dim].to_vec();
+    let mut interval = BTreeMap::new();
+    for (p, name) in problem.kind.param_names().iter().enumerate() {
+        let vals: Vec<f64> = (0..total)
+            .filter(|&i| costs[i] == costs[best_i])
+            .map(|i| cands[i * dim + p])
+            .collect();
+        let (a, b) = range(&vals);
+        interval.insert(name.to_string(), [a, b]);
+    }
+    Outcome {
+        best,
+        interval,
+        interval_kind: "grid",
+        evaluations: total as u64,
+        cells: None,
+    }
+}
+
+/// Along each axis from the estimate, the stretch over which the cost stays at the optimum
+/// (the objective is a step function of the stiction parameters): doubling steps out, then bisection.
+fn axis_intervals(
+    problem: &Hammerstein,
+    best: &[f64],
+    bounds: &[(f64, f64)],
+    best_cost: f64,
+) -> (BTreeMap<String, [f64; 2]>, u64) {
+    let mut out = BTreeMap::new();
+    let mut evals = 0u64;
+    let names = problem.kind.param_names();
+    for (p, &(lo, hi)) in bounds.iter().enumerate() {
+        let mut ends = [best[p]; 2];
+        for (side, end) in ends.iter_mut().enumerate() {
+            let limit = if side == 0 { lo } else { hi };
+            let at = |v: f64| {
+                let mut theta = best.to_vec();
+                theta[p] = v;
+                problem.kind.repair(&mut theta);
+                // a repair that moves another parameter leaves this axis
+                (theta[p] == v).then(|| problem.cost(&theta))
+            };
+            let same = |c: Option<f64>| c.is_some_and(|c| c <= best_cost);
+            // step out until the cost changes or the bound is reached
+            let mut inside = best[p];
+            let mut step = 1e-4 * (hi - lo);
+            let mut outside = None;
+            for _ in 0..40 {
+                let v = if side == 0 {
+                    (inside - step).max(limit)
+                } else {
+                    (inside + step).min(limit)
+                };
+                evals += 1;
+                if same(at(v)) {
+                    inside = v;
+                    if v == limit {
+                        break;
+                    }
+                    step *= 2.0;
+                } else {
+                    outside = Some(v);
+                    break;
+                }
+            }
+            if let Some(mut out_v) = outside {
+                for _ in 0..30 {
+                    let mid = 0.5 * (inside + out_v);
+                    evals += 1;
+                    if same(at(mid)) {
+                        inside = mid;
+                    } else {
+                        out_v = mid;
+                    }
+                }
+            }
+            *end = inside;
+        }
+        out.insert(names[p].to_string(), ends);
+    }
+    (out, evals)
+}
