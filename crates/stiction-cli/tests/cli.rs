@@ -476,3 +476,162 @@ fn bad_bounds_and_names() {
     );
     fails(&["reproduce", "everything"], &["unknown target", "paper"]);
 }
+
+// ----------------------------------------------------------------------------- quantify
+
+fn closed_loop(dir: &Path, d: &str) -> String {
+    let p = dir.join("loop.csv");
+    let f = p.to_str().unwrap();
+    ok(&[
+        "simulate",
+        "--loop",
+        "closed",
+        "--model",
+        "stenman",
+        "--param",
+        &format!("d={d}"),
+        "--samples",
+        "1500",
+        "--noise",
+        "0.02",
+        "--seed",
+        "4",
+        "-o",
+        f,
+    ]);
+    f.to_string()
+}
+
+#[test]
+fn quantify_from_op_and_pv_json_and_plots() {
+    let dir = tmp();
+    let f = closed_loop(dir.path(), "1");
+    let plots = dir.path().join("plots");
+    let v = json(&ok(&[
+        "quantify",
+        &f,
+        "--op",
+        "op",
+        "--pv",
+        "pv",
+        "--json",
+        "--plot",
+        plots.to_str().unwrap(),
+    ]));
+    assert_eq!(v["status"], "ok");
+    for key in [
+        "model",
+        "method",
+        "params",
+        "interval",
+        "linear_model",
+        "fit",
+        "apparent_stiction",
+        "evaluations",
+        "seconds",
+    ] {
+        assert!(v.get(key).is_some(), "no {key}");
+    }
+    for key in [
+        "na",
+        "nb",
+        "nk",
+        "a",
+        "b",
+        "gain",
+        "time_constant",
+        "dead_time",
+    ] {
+        assert!(
+            v["linear_model"].get(key).is_some(),
+            "no linear_model.{key}"
+        );
+    }
+    assert!(v["fit"]["r2_simulation"].as_f64().unwrap() > 0.9);
+    assert!(v["fit"]["r2_one_step"].is_number());
+    let d = v["params"]["d"].as_f64().unwrap();
+    assert!((d - 1.0).abs() < 0.1, "d = {d}");
+    assert_eq!(v["linear_model"]["nk"], 11);
+    assert!(v["caveat"]
+        .as_str()
+        .unwrap()
+        .contains("without the valve position"));
+    for stem in ["phase_plot", "trends"] {
+        for ext in ["png", "svg"] {
+            assert!(plots.join(format!("{stem}.{ext}")).exists(), "{stem}.{ext}");
+        }
+    }
+    let human = ok(&["quantify", &f]);
+    assert!(
+        human.contains("apparent stiction") && human.contains("without the valve position"),
+        "{human}"
+    );
+    assert!(human.contains("delay 11 samples"), "{human}");
+}
+
+#[test]
+fn quantify_two_parameter_model() {
+    let dir = tmp();
+    let f = closed_loop(dir.path(), "2");
+    let v = json(&ok(&[
+        "quantify",
+        &f,
+        "--model",
+        "kano",
+        "--method",
+        "aco-r",
+        "--iterations",
+        "20",
+        "--seed",
+        "3",
+        "--json",
+    ]));
+    assert_eq!(v["method"], "aco-r");
+    assert!(v["params"]["S"].is_number() && v["params"]["J"].is_number());
+    assert_eq!(v["seed"], 3);
+}
+
+#[test]
+fn quantify_bad_input_and_insufficient_data() {
+    let dir = tmp();
+    let f = closed_loop(dir.path(), "1");
+    fails(
+        &["quantify", &f, "--pv", "level"],
+        &["loop.csv", "'level'", "--pv"],
+    );
+    fails(
+        &["quantify", &f, "--model", "kano", "--method", "exact"],
+        &["exact", "Stenman model only"],
+    );
+    fails(&["quantify", &f, "--ts", "0"], &["--ts", "positive"]);
+    // too short: a clear error in words, a status in JSON
+    let short: String = std::fs::read_to_string(&f)
+        .unwrap()
+        .lines()
+        .take(40)
+        .collect::<Vec<_>>()
+        .join("\n");
+    let s = write(dir.path(), "short.csv", &short);
+    fails(
+        &["quantify", &s],
+        &["short.csv", "insufficient data", "samples"],
+    );
+    let v = json(&ok(&["quantify", &s, "--json"]));
+    assert_eq!(v["status"], "insufficient_data");
+    assert!(v["reason"].as_str().unwrap().contains("samples"));
+    // a constant PV
+    let mut text = String::from("t,op,pv\n");
+    for k in 0..500 {
+        text.push_str(&format!("{k},{},20\n", 50.0 + (k as f64 * 0.1).sin()));
+    }
+    let c = write(dir.path(), "flat.csv", &text);
+    fails(&["quantify", &c], &["flat.csv", "PV is constant"]);
+    // OP saturated the whole time
+    let mut text = String::from("t,op,pv\n");
+    for k in 0..500 {
+        text.push_str(&format!("{k},100,{}\n", 20.0 + (k as f64 * 0.1).sin()));
+    }
+    let c = write(dir.path(), "sat.csv", &text);
+    let v = json(&ok(&["quantify", &c, "--json"]));
+    assert_eq!(v["status"], "insufficient_data");
+}

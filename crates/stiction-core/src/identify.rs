@@ -87,6 +87,8 @@ pub struct Data<'a> {
     y_diff: Vec<f64>,
     mean_level: f64,
     mean_diff: f64,
+    /// Smallest error sum of squares the criteria distinguish.
+    floor: f64,
 }
 
 impl<'a> Data<'a> {
@@ -102,10 +104,18 @@ impl<'a> Data<'a> {
         } else {
             0.0
         };
+        let y_level: Vec<f64> = pv.iter().map(|v| v - mean_level).collect();
+        let floor = 1e-10
+            * y_level
+                .iter()
+                .map(|v| v * v)
+                .sum::<f64>()
+                .max(f64::MIN_POSITIVE);
         Self {
             pv,
             t0,
-            y_level: pv.iter().map(|v| v - mean_level).collect(),
+            floor,
+            y_level,
             y_diff: diff.iter().map(|v| v - mean_diff).collect(),
             mean_level,
             mean_diff,
@@ -528,12 +538,12 @@ impl FullGram {
     }
 }
 
-/// Bayesian information criterion of a one-step fit (with a floor, so perfect noise-free fits
-/// still prefer the smaller structure).
-pub fn bic(sse: f64, sst: f64, used: usize, params: usize) -> f64 {
-    let n = used as f64;
-    let floor = 1e-10 * sst.max(f64::MIN_POSITIVE);
-    n * (sse.max(floor) / n).ln() + params as f64 * n.ln()
+/// Bayesian information criterion of a fit's error sum of squares, with a floor (a fraction of
+/// the PV's variance, the same for both families) so that perfect noise-free fits still prefer the
+/// smaller structure.
+pub fn bic(sse: f64, data: &Data, params: usize) -> f64 {
+    let n = data.used() as f64;
+    n * (sse.max(data.floor) / n).ln() + params as f64 * n.ln()
 }
 
 /// Choose the linear structure for one valve trajectory (`mv` centred): the least BIC of one-step
@@ -555,7 +565,7 @@ pub fn select(data: &Data, mv: &[f64], range: &SearchRange) -> Option<Selection>
             .filter(|s| s.integrating == integrating)
         {
             if let Some((theta, sse)) = gram.solve(s) {
-                let crit = bic(sse, gram.yy, data.used(), s.na + s.nb + 1);
+                let crit = bic(sse, data, s.na + s.nb + 1);
                 if best.is_none_or(|b| crit < b.2) {
                     best = Some((s, theta, crit));
                 }
@@ -564,7 +574,6 @@ pub fn select(data: &Data, mv: &[f64], range: &SearchRange) -> Option<Selection>
     }
     let (s, theta, one_step_bic) = best?;
     let y = data.y(s.integrating);
-    let sst: f64 = y[data.t0..].iter().map(|v| v * v).sum();
     let p = s.na + s.nb + 1;
     let sse = simulate_sse(
         y,
@@ -578,7 +587,7 @@ pub fn select(data: &Data, mv: &[f64], range: &SearchRange) -> Option<Selection>
     );
     Some(Selection {
         structure: s,
-        simulation_bic: bic(sse, sst, data.used(), p),
+        simulation_bic: bic(sse, data, p),
         one_step_bic,
     })
 }
@@ -595,7 +604,7 @@ pub struct Selection {
 /// BIC of a fit's simulation error (the criterion `select` ranks structures by).
 pub fn simulation_bic(data: &Data, f: &Fit) -> f64 {
     let s = f.structure;
-    bic(f.sse_simulation, f.sst, data.used(), s.na + s.nb + 1)
+    bic(f.sse_simulation, data, s.na + s.nb + 1)
 }
 
 /// Gain, time constant and dead time where they follow from the fitted coefficients.
