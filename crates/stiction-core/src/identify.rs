@@ -228,19 +228,25 @@ impl<'a> Prepared<'a> {
 
     /// Least squares and simulation for one valve trajectory.
     pub fn fit(&self, mv: &[f64]) -> Option<Fit> {
+        self.fit_bounded(mv, f64::INFINITY)
+    }
+
+    /// As [`Prepared::fit`], but the simulation stops as soon as its error exceeds `bound`
+    /// (the fit can then not be the best, and its `sse_simulation` is infinite).
+    pub fn fit_bounded(&self, mv: &[f64], bound: f64) -> Option<Fit> {
         // the orders are compile-time constants inside, so the loops unroll
         match (self.s.na, self.s.nb) {
-            (0, 1) => self.fit_n::<0, 1>(mv),
-            (0, 2) => self.fit_n::<0, 2>(mv),
-            (1, 1) => self.fit_n::<1, 1>(mv),
-            (1, 2) => self.fit_n::<1, 2>(mv),
-            (2, 1) => self.fit_n::<2, 1>(mv),
-            (2, 2) => self.fit_n::<2, 2>(mv),
+            (0, 1) => self.fit_n::<0, 1>(mv, bound),
+            (0, 2) => self.fit_n::<0, 2>(mv, bound),
+            (1, 1) => self.fit_n::<1, 1>(mv, bound),
+            (1, 2) => self.fit_n::<1, 2>(mv, bound),
+            (2, 1) => self.fit_n::<2, 1>(mv, bound),
+            (2, 2) => self.fit_n::<2, 2>(mv, bound),
             _ => unreachable!("orders are checked when prepared"),
         }
     }
 
-    fn fit_n<const NA: usize, const NB: usize>(&self, mv: &[f64]) -> Option<Fit> {
+    fn fit_n<const NA: usize, const NB: usize>(&self, mv: &[f64], bound: f64) -> Option<Fit> {
         let (s, y, t0) = (self.s, self.y, self.t0);
         let nk = s.nk;
         // the valve's own sums: mv-lag x mv-lag, y-lag x mv-lag, mv-lag, y x mv-lag
@@ -296,7 +302,7 @@ impl<'a> Prepared<'a> {
         let a: [f64; NA] = std::array::from_fn(|i| theta[i]);
         let b: [f64; NB] = std::array::from_fn(|j| theta[NA + j]);
         let c = theta[p - 1];
-        let sse_simulation = simulate_n::<NA, NB>(y, mv, nk, &a, &b, c, t0, None);
+        let sse_simulation = simulate_n::<NA, NB>(y, mv, nk, &a, &b, c, t0, None, bound);
         Some(Fit {
             structure: s,
             a: a.to_vec(),
@@ -376,6 +382,7 @@ fn simulate_sse(
                 c,
                 t0,
                 out,
+                f64::INFINITY,
             )
         };
     }
@@ -401,6 +408,7 @@ fn simulate_n<const NA: usize, const NB: usize>(
     c: f64,
     t0: usize,
     mut out: Option<&mut Vec<f64>>,
+    bound: f64,
 ) -> f64 {
     let n = y.len();
     // the last NA simulated outputs, newest first
@@ -436,6 +444,10 @@ fn simulate_n<const NA: usize, const NB: usize>(
         sse += e * e;
         if let Some(o) = out.as_deref_mut() {
             o.push(v);
+        }
+        // checked every 64 samples: cheap, and most wrong trajectories are out within a few hundred
+        if k % 64 == 63 && sse > bound {
+            return f64::INFINITY;
         }
     }
     if sse.is_finite() {

@@ -410,54 +410,70 @@ pub fn quantify(
     // search again with a new one if it differs; keep the answer whose simulation BIC is least
     let mut seed = None;
     let mut tried: Vec<(Structure, Outcome, f64)> = Vec::new();
-    while let Some(structure) = queue.pop_front() {
-        if tried.iter().any(|t| t.0 == structure) || tried.len() >= MOST_STRUCTURES {
-            continue;
+    while !queue.is_empty() && tried.len() < MOST_STRUCTURES {
+        // the structures of this round: for Stenman exact all queued ones share one walk
+        let mut round: Vec<Structure> = Vec::new();
+        while let Some(s) = queue.pop_front() {
+            if !tried.iter().any(|t| t.0 == s)
+                && !round.contains(&s)
+                && tried.len() + round.len() < MOST_STRUCTURES
+            {
+                round.push(s);
+            }
+            if req.method != Method::Exact && !round.is_empty() {
+                break;
+            }
         }
-        let problem = Hammerstein::new(req.model, op, &data, structure);
-        let outcome = match req.method {
-            Method::Exact => exact_stenman(&problem, bounds[0], req.full_partition),
-            Method::Grid => grid_search(&problem, &bounds, &req.grid),
+        if round.is_empty() {
+            break;
+        }
+        let problems: Vec<Hammerstein> = round
+            .iter()
+            .map(|&s| Hammerstein::new(req.model, op, &data, s))
+            .collect();
+        let outcomes = match req.method {
+            Method::Exact => exact_stenman(&problems, bounds[0], req.full_partition),
+            Method::Grid => vec![grid_search(&problems[0], &bounds, &req.grid)],
             Method::Aco | Method::AcoR => {
+                let problem = &problems[0];
                 seed = Some(req.seed);
                 let mut rng = seeded(req.seed);
-                let mut ev = Evaluator::new(&problem);
-                // the Stenman band is a good first guess for the two-parameter models: Kano and
-                // Choudhury with J = S, He with fd = 0 behave alike
-                let stenman_evals = 0;
+                let mut ev = Evaluator::new(problem);
                 if req.method == Method::Aco {
                     let mut s = aco::PaperAco::new(req.aco.clone(), req.model, &bounds);
                     solver::run(&mut s, &mut ev, &mut rng, req.aco.iterations, false);
                 } else {
-                    let seeds = stenman_d
-                        .map(|d| first_guesses(req.model, d))
-                        .unwrap_or_default();
-                    let mut s =
-                        acor::Acor::new(req.acor.clone(), req.model, &bounds).with_seeds(seeds);
+                    // the Stenman band is a good first guess for the two-parameter models:
+                    // Kano and Choudhury with J = S, He with fd = 0 behave alike
+                    let seeds = stenman_d.map(|d| first_guesses(req.model, d)).unwrap_or_default();
+                    let mut s = acor::Acor::new(req.acor.clone(), req.model, &bounds).with_seeds(seeds);
                     solver::run(&mut s, &mut ev, &mut rng, req.acor.iterations, false);
                 }
-                let (best, cost, polish_evals) =
-                    polish(&problem, ev.best(), ev.best_cost(), &bounds);
-                let (interval, extra) = axis_intervals(&problem, &best, &bounds, cost);
-                Outcome {
+                let (best, cost, polish_evals) = polish(problem, ev.best(), ev.best_cost(), &bounds);
+                let (interval, extra) = axis_intervals(problem, &best, &bounds, cost);
+                vec![Outcome {
                     best,
                     interval,
                     interval_kind: "axis",
-                    evaluations: ev.evaluations() + extra + stenman_evals + polish_evals,
+                    evaluations: ev.evaluations() + extra + polish_evals,
                     cells: None,
-                }
+                }]
             }
         };
-        evaluations += outcome.evaluations;
-        let criterion = problem
-            .fit(&outcome.best)
-            .map_or(f64::INFINITY, |f| identify::simulation_bic(&data, &f));
-        let mv_c = problem.valve(&outcome.best);
-        tried.push((structure, outcome, criterion));
-        evaluations += 1;
-        if let Some(next) = identify::select(&data, &mv_c, &search) {
-            if !tried.iter().any(|t| t.0 == next.structure) {
-                queue.push_front(next.structure);
+        // a walk shared by several structures counts once
+        evaluations += outcomes.iter().map(|o| o.evaluations).max().unwrap_or(0);
+        for (problem, outcome) in problems.iter().zip(outcomes) {
+            let criterion = problem
+                .fit(&outcome.best)
+                .map_or(f64::INFINITY, |f| identify::simulation_bic(&data, &f));
+            let mv_c = problem.valve(&outcome.best);
+            tried.push((problem.prepared.structure(), outcome, criterion));
+            evaluations += 1;
+            // confirm the structure at this answer; a different one is searched next round
+            if let Some(next) = identify::select(&data, &mv_c, &search) {
+                if !tried.iter().any(|t| t.0 == next.structure) && !queue.contains(&next.structure) {
+                    queue.push_back(next.structure);
+                }
             }
         }
     }
@@ -676,10 +692,11 @@ fn pilot_points(kind: ModelKind, bounds: &[(f64, f64)]) -> Vec<Vec<f64>> {
 }
 
 /// Stenman, exact: every distinct valve trajectory (cell of the partition of the d-range) is
-/// fitted once. The range is cut into fixed chunks walked in parallel, so the work spreads over
-/// threads and the result does not depend on their number. Without `full`, only the chunks around
-/// the best points of a coarse scan are walked (faster, exact only there).
-fn exact_stenman(problem: &Hammerstein, (lo, hi): (f64, f64), full: bool) -> Outcome {
+/// simulated once and fitted with each of the given linear structures. The range is cut into fixed
+/// chunks walked in parallel, so the work spreads over threads and the result does not depend on
+/// their number. Without `full`, only the chunks around the best points of a coarse scan are walked
+/// (faster, exact only there). One outcome per structure, in order.
+fn exact_stenman(problems: &[Hammerstein], (lo, hi): (f64, f64), full: bool) -> Vec<Outcome> {
     const CHUNKS: usize = 64;
     let first = (hi - lo) * 1e-4;
     let mut edges: Vec<f64> = (0..CHUNKS)
@@ -689,16 +706,20 @@ fn exact_stenman(problem: &Hammerstein, (lo, hi): (f64, f64), full: bool) -> Out
     edges.push(hi);
     edges.dedup();
     let mut chunks: Vec<(f64, f64)> = edges.windows(2).map(|w| (w[0], w[1])).collect();
+    let scan: Vec<f64> = chunks.iter().map(|c| 0.5 * (c.0 + c.1)).collect();
+    let scan_costs: Vec<Vec<f64>> = problems.iter().map(|p| p.costs_1d(&scan)).collect();
     if !full {
-        let mids: Vec<f64> = chunks.iter().map(|c| 0.5 * (c.0 + c.1)).collect();
-        let costs = problem.costs_1d(&mids);
-        let mut order: Vec<usize> = (0..chunks.len()).collect();
-        order.sort_by(|&i, &j| costs[i].total_cmp(&costs[j]));
-        let keep: Vec<usize> = order
-            .iter()
-            .take(3)
-            .flat_map(|&i| [i.saturating_sub(1), i, (i + 1).min(chunks.len() - 1)])
-            .collect();
+        let mut keep = Vec::new();
+        for costs in &scan_costs {
+            let mut order: Vec<usize> = (0..chunks.len()).collect();
+            order.sort_by(|&i, &j| costs[i].total_cmp(&costs[j]));
+            keep.extend(
+                order
+                    .iter()
+                    .take(3)
+                    .flat_map(|&i| [i.saturating_sub(1), i, (i + 1).min(chunks.len() - 1)]),
+            );
+        }
         chunks = chunks
             .iter()
             .enumerate()
@@ -706,56 +727,76 @@ fn exact_stenman(problem: &Hammerstein, (lo, hi): (f64, f64), full: bool) -> Out
             .map(|(_, &c)| c)
             .collect();
     }
-    let n = problem.op.len();
-    let per_chunk: Vec<Vec<((f64, f64), f64)>> = chunks
+    // achievable costs to start from: simulations that exceed them stop early (such a cell can
+    // never be optimal, so the optimal set is the same whatever the order of the work)
+    let start_bounds: Vec<f64> = scan_costs
+        .iter()
+        .map(|c| c.iter().copied().fold(f64::INFINITY, f64::min))
+        .collect();
+    let n = problems[0].op.len();
+    let offset = problems[0].offset;
+    let per_chunk: Vec<Vec<((f64, f64), Vec<f64>)>> = chunks
         .par_iter()
         .map_init(
             || vec![0.0; n],
             |mv, &chunk| {
                 let mut out = Vec::new();
-                exact::stenman_walk(problem.op, chunk, (lo, hi), mv, |cell, mv| {
+                let mut bounds = start_bounds.clone();
+                exact::stenman_walk(problems[0].op, chunk, (lo, hi), mv, |cell, mv| {
                     for v in mv.iter_mut() {
-                        *v -= problem.offset;
+                        *v -= offset;
                     }
-                    let cost = problem
-                        .prepared
-                        .fit(mv)
-                        .map_or(f64::INFINITY, |f| f.sse_simulation);
-                    out.push((cell, cost));
+                    let costs: Vec<f64> = problems
+                        .iter()
+                        .zip(bounds.iter_mut())
+                        .map(|(p, bound)| {
+                            let c = p
+                                .prepared
+                                .fit_bounded(mv, *bound)
+                                .map_or(f64::INFINITY, |f| f.sse_simulation);
+                            *bound = bound.min(c);
+                            c
+                        })
+                        .collect();
+                    out.push((cell, costs));
                 });
                 out
             },
         )
         .collect();
-    let cells: Vec<((f64, f64), f64)> = per_chunk.into_iter().flatten().collect();
-    let best = cells.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
-    let mut optimal: Vec<(f64, f64)> = Vec::new();
-    for &(cell, cost) in &cells {
-        if cost == best {
-            match optimal.last_mut() {
-                // pieces of one cell split at a chunk edge join again
-                Some(last) if last.1 >= cell.0 => last.1 = last.1.max(cell.1),
-                _ => optimal.push(cell),
+    let cells: Vec<((f64, f64), Vec<f64>)> = per_chunk.into_iter().flatten().collect();
+    (0..problems.len())
+        .map(|s| {
+            let best = cells.iter().map(|c| c.1[s]).fold(f64::INFINITY, f64::min);
+            let mut optimal: Vec<(f64, f64)> = Vec::new();
+            for (cell, costs) in &cells {
+                if costs[s] == best {
+                    match optimal.last_mut() {
+                        // pieces of one cell split at a chunk edge join again
+                        Some(last) if last.1 >= cell.0 => last.1 = last.1.max(cell.1),
+                        _ => optimal.push(*cell),
+                    }
+                }
             }
-        }
-    }
-    // the widest optimal piece's midpoint is the point estimate; the interval is their hull
-    let (a, b) = optimal
-        .iter()
-        .copied()
-        .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
-        .unwrap_or((lo, hi));
-    let hull = [
-        optimal.first().map_or(lo, |c| c.0),
-        optimal.last().map_or(hi, |c| c.1),
-    ];
-    Outcome {
-        best: vec![0.5 * (a + b)],
-        interval: BTreeMap::from([("d".to_string(), hull)]),
-        interval_kind: if full { "exact" } else { "exact_local" },
-        evaluations: cells.len() as u64,
-        cells: Some(cells.len()),
-    }
+            // the widest optimal piece's midpoint is the point estimate; the interval their hull
+            let (a, b) = optimal
+                .iter()
+                .copied()
+                .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+                .unwrap_or((lo, hi));
+            let hull = [
+                optimal.first().map_or(lo, |c| c.0),
+                optimal.last().map_or(hi, |c| c.1),
+            ];
+            Outcome {
+                best: vec![0.5 * (a + b)],
+                interval: BTreeMap::from([("d".to_string(), hull)]),
+                interval_kind: if full { "exact" } else { "exact_local" },
+                evaluations: (cells.len() + scan.len()) as u64,
+                cells: Some(cells.len()),
+            }
+        })
+        .collect()
 }
 
 fn grid_search(problem: &Hammerstein, bounds: &[(f64, f64)], settings: &GridSettings) -> Outcome {
