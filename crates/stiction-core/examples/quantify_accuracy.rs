@@ -283,8 +283,14 @@ fn report(rows: &[Row], total: f64, seeds: usize) -> String {
         .iter()
         .filter(|r| (r.noise == 0.0 && r.rel_err > 0.05) || (r.noise == 0.05 && r.rel_err > 0.10))
         .collect();
-    let _ = writeln!(s, "Noise-free cases beyond 5 % and 5 %-noise cases beyond 10 %:\n");
-    let _ = writeln!(s, "| valve | process | noise | seed | estimate | rel. error | limit cycle | linear model |");
+    let _ = writeln!(
+        s,
+        "Noise-free cases beyond 5 % and 5 %-noise cases beyond 10 %:\n"
+    );
+    let _ = writeln!(
+        s,
+        "| valve | process | noise | seed | estimate | rel. error | limit cycle | linear model |"
+    );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
     for r in &misses {
         let _ = writeln!(
@@ -294,7 +300,11 @@ fn report(rows: &[Row], total: f64, seeds: usize) -> String {
             r.plant,
             100.0 * r.noise,
             r.seed,
-            r.estimate.iter().map(|v| format!("{v:.3}")).collect::<Vec<_>>().join(", "),
+            r.estimate
+                .iter()
+                .map(|v| format!("{v:.3}"))
+                .collect::<Vec<_>>()
+                .join(", "),
             100.0 * r.rel_err,
             if r.cycling { "yes" } else { "no" },
             r.structure

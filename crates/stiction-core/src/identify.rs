@@ -174,6 +174,15 @@ pub fn fit(data: &Data, mv: &[f64], s: Structure) -> Option<Fit> {
     Prepared::new(data, s).fit(mv)
 }
 
+/// The sums of a least-squares fit that involve the valve position.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ValveSums {
+    mm: [[f64; 2]; 2],
+    ym: [[f64; 2]; 2],
+    m1: [f64; 2],
+    hm: [f64; 2],
+}
+
 /// Everything of a fit that depends only on the PV, computed once per structure: the many valve
 /// trajectories a search tries then cost one pass each for their own sums and one simulation.
 pub struct Prepared<'a> {
@@ -247,6 +256,76 @@ impl<'a> Prepared<'a> {
     }
 
     fn fit_n<const NA: usize, const NB: usize>(&self, mv: &[f64], bound: f64) -> Option<Fit> {
+        let sums = self.sums_n::<NA, NB>(mv);
+        self.finish_n::<NA, NB>(&sums, mv, bound)
+    }
+
+    /// The valve's own sums for a whole trajectory.
+    pub fn sums(&self, mv: &[f64]) -> ValveSums {
+        match (self.s.na, self.s.nb) {
+            (0, 1) => self.sums_n::<0, 1>(mv),
+            (0, 2) => self.sums_n::<0, 2>(mv),
+            (1, 1) => self.sums_n::<1, 1>(mv),
+            (1, 2) => self.sums_n::<1, 2>(mv),
+            (2, 1) => self.sums_n::<2, 1>(mv),
+            (2, 2) => self.sums_n::<2, 2>(mv),
+            _ => unreachable!("orders are checked when prepared"),
+        }
+    }
+
+    /// Bring `sums` from trajectory `old` to `new`, which differ only at the samples `changed`
+    /// (sorted): only the regression rows that see a changed sample are touched.
+    pub fn update_sums(
+        &self,
+        sums: &mut ValveSums,
+        old: &[f64],
+        new: &[f64],
+        changed: &[usize],
+        rows: &mut Vec<usize>,
+    ) {
+        let (s, y, t0, n) = (self.s, self.y, self.t0, self.y.len());
+        rows.clear();
+        for &i in changed {
+            for j in 0..s.nb {
+                let t = i + s.nk + j;
+                if t >= t0 && t < n {
+                    rows.push(t);
+                }
+            }
+        }
+        rows.sort_unstable();
+        rows.dedup();
+        for &t in rows.iter() {
+            for (mv, sign) in [(old, -1.0), (new, 1.0)] {
+                let m = [mv[t - s.nk], if s.nb > 1 { mv[t - s.nk - 1] } else { 0.0 }];
+                for j in 0..s.nb {
+                    sums.m1[j] += sign * m[j];
+                    sums.hm[j] += sign * y[t] * m[j];
+                    for k in j..s.nb {
+                        sums.mm[j][k] += sign * m[j] * m[k];
+                    }
+                    for i in 0..s.na {
+                        sums.ym[i][j] += sign * y[t - 1 - i] * m[j];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Least squares from the sums, then the simulation (stopped once its error exceeds `bound`).
+    pub fn fit_from_sums(&self, sums: &ValveSums, mv: &[f64], bound: f64) -> Option<Fit> {
+        match (self.s.na, self.s.nb) {
+            (0, 1) => self.finish_n::<0, 1>(sums, mv, bound),
+            (0, 2) => self.finish_n::<0, 2>(sums, mv, bound),
+            (1, 1) => self.finish_n::<1, 1>(sums, mv, bound),
+            (1, 2) => self.finish_n::<1, 2>(sums, mv, bound),
+            (2, 1) => self.finish_n::<2, 1>(sums, mv, bound),
+            (2, 2) => self.finish_n::<2, 2>(sums, mv, bound),
+            _ => unreachable!("orders are checked when prepared"),
+        }
+    }
+
+    fn sums_n<const NA: usize, const NB: usize>(&self, mv: &[f64]) -> ValveSums {
         let (s, y, t0) = (self.s, self.y, self.t0);
         let nk = s.nk;
         // the valve's own sums: mv-lag x mv-lag, y-lag x mv-lag, mv-lag, y x mv-lag
@@ -274,6 +353,18 @@ impl<'a> Prepared<'a> {
                 }
             }
         }
+        ValveSums { mm, ym, m1, hm }
+    }
+
+    fn finish_n<const NA: usize, const NB: usize>(
+        &self,
+        sums: &ValveSums,
+        mv: &[f64],
+        bound: f64,
+    ) -> Option<Fit> {
+        let (s, y, t0) = (self.s, self.y, self.t0);
+        let nk = s.nk;
+        let ValveSums { mm, ym, m1, hm } = *sums;
         // assemble [y-lags, mv-lags, 1] (upper triangle)
         let p = NA + NB + 1;
         let mut g = [[0.0f64; MAX_P]; MAX_P];

@@ -445,11 +445,15 @@ pub fn quantify(
                 } else {
                     // the Stenman band is a good first guess for the two-parameter models:
                     // Kano and Choudhury with J = S, He with fd = 0 behave alike
-                    let seeds = stenman_d.map(|d| first_guesses(req.model, d)).unwrap_or_default();
-                    let mut s = acor::Acor::new(req.acor.clone(), req.model, &bounds).with_seeds(seeds);
+                    let seeds = stenman_d
+                        .map(|d| first_guesses(req.model, d))
+                        .unwrap_or_default();
+                    let mut s =
+                        acor::Acor::new(req.acor.clone(), req.model, &bounds).with_seeds(seeds);
                     solver::run(&mut s, &mut ev, &mut rng, req.acor.iterations, false);
                 }
-                let (best, cost, polish_evals) = polish(problem, ev.best(), ev.best_cost(), &bounds);
+                let (best, cost, polish_evals) =
+                    polish(problem, ev.best(), ev.best_cost(), &bounds);
                 let (interval, extra) = axis_intervals(problem, &best, &bounds, cost);
                 vec![Outcome {
                     best,
@@ -471,7 +475,8 @@ pub fn quantify(
             evaluations += 1;
             // confirm the structure at this answer; a different one is searched next round
             if let Some(next) = identify::select(&data, &mv_c, &search) {
-                if !tried.iter().any(|t| t.0 == next.structure) && !queue.contains(&next.structure) {
+                if !tried.iter().any(|t| t.0 == next.structure) && !queue.contains(&next.structure)
+                {
                     queue.push_back(next.structure);
                 }
             }
@@ -735,29 +740,49 @@ fn exact_stenman(problems: &[Hammerstein], (lo, hi): (f64, f64), full: bool) -> 
         .collect();
     let n = problems[0].op.len();
     let offset = problems[0].offset;
+    // Consecutive cells' trajectories differ only on short stretches (they join again at the next
+    // slip both make), so each walk keeps the least-squares sums of its previous cell and updates
+    // only the rows that see a changed sample; a full recomputation now and then bounds rounding.
+    const FULL_EVERY: usize = 256;
     let per_chunk: Vec<Vec<((f64, f64), Vec<f64>)>> = chunks
         .par_iter()
         .map_init(
-            || vec![0.0; n],
-            |mv, &chunk| {
+            || (vec![0.0; n], vec![0.0; n], Vec::new(), Vec::new()),
+            |(mv, prev, changed, rows), &chunk| {
                 let mut out = Vec::new();
                 let mut bounds = start_bounds.clone();
+                let mut sums: Vec<identify::ValveSums> = Vec::new();
                 exact::stenman_walk(problems[0].op, chunk, (lo, hi), mv, |cell, mv| {
                     for v in mv.iter_mut() {
                         *v -= offset;
                     }
+                    changed.clear();
+                    if !sums.is_empty() && out.len() % FULL_EVERY != 0 {
+                        changed.extend((0..n).filter(|&i| mv[i] != prev[i]));
+                    }
+                    let incremental =
+                        !sums.is_empty() && out.len() % FULL_EVERY != 0 && changed.len() < n / 8;
+                    if incremental {
+                        for (p, s) in problems.iter().zip(sums.iter_mut()) {
+                            p.prepared.update_sums(s, prev, mv, changed, rows);
+                        }
+                    } else {
+                        sums = problems.iter().map(|p| p.prepared.sums(mv)).collect();
+                    }
                     let costs: Vec<f64> = problems
                         .iter()
+                        .zip(&sums)
                         .zip(bounds.iter_mut())
-                        .map(|(p, bound)| {
+                        .map(|((p, s), bound)| {
                             let c = p
                                 .prepared
-                                .fit_bounded(mv, *bound)
+                                .fit_from_sums(s, mv, *bound)
                                 .map_or(f64::INFINITY, |f| f.sse_simulation);
                             *bound = bound.min(c);
                             c
                         })
                         .collect();
+                    prev.copy_from_slice(mv);
                     out.push((cell, costs));
                 });
                 out
@@ -768,9 +793,12 @@ fn exact_stenman(problems: &[Hammerstein], (lo, hi): (f64, f64), full: bool) -> 
     (0..problems.len())
         .map(|s| {
             let best = cells.iter().map(|c| c.1[s]).fold(f64::INFINITY, f64::min);
+            // sums updated step by step round differently from fresh ones: a hair of tolerance
+            // keeps the pieces of one trajectory together
+            let tolerance = 1e-9 * best.abs();
             let mut optimal: Vec<(f64, f64)> = Vec::new();
             for (cell, costs) in &cells {
-                if costs[s] == best {
+                if costs[s] <= best + tolerance {
                     match optimal.last_mut() {
                         // pieces of one cell split at a chunk edge join again
                         Some(last) if last.1 >= cell.0 => last.1 = last.1.max(cell.1),
