@@ -1,5 +1,5 @@
 use crate::{cmd_simulate::write_atomic, data, spec};
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use std::path::PathBuf;
 use stiction_core::estimate::{self, Estimate, Method, Request};
 use stiction_core::models::ModelKind;
@@ -146,32 +146,12 @@ fn bounds(kind: ModelKind, a: &Args) -> Result<Option<Vec<(f64, f64)>>> {
     if a.lo.is_none() && a.hi.is_none() && a.bounds.is_empty() {
         return Ok(None);
     }
-    let mut b: Vec<(f64, f64)> = kind
+    let defaults = kind
         .params()
         .iter()
         .map(|p| (a.lo.unwrap_or(p.search.0), a.hi.unwrap_or(p.search.1)))
         .collect();
-    for text in &a.bounds {
-        let parsed = text.split_once('=').and_then(|(n, r)| {
-            let (lo, hi) = r.split_once(':')?;
-            Some((
-                n.trim(),
-                lo.trim().parse::<f64>().ok()?,
-                hi.trim().parse::<f64>().ok()?,
-            ))
-        });
-        let (name, lo, hi) = parsed.with_context(|| {
-            format!(
-                "--bounds {text}: write NAME=LO:HI, e.g. --bounds {}=0.01:10",
-                kind.param_names()[0]
-            )
-        })?;
-        let i = kind
-            .param_index(name)
-            .map_err(|e| anyhow::anyhow!("--bounds: {e}"))?;
-        b[i] = (lo, hi);
-    }
-    Ok(Some(b))
+    spec::bounds(kind, &a.bounds, defaults).map(Some)
 }
 
 fn write_trace(path: &std::path::Path, kind: ModelKind, est: &Estimate) -> Result<()> {

@@ -128,27 +128,11 @@ pub fn run(a: Args) -> Result<()> {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
                 (l.min(v), h.max(v))
             });
-        let mut b = vec![(0.0, (hi - lo).max(f64::MIN_POSITIVE)); kind.dim()];
-        for text in &a.bounds {
-            let parsed = text.split_once('=').and_then(|(n, r)| {
-                let (lo, hi) = r.split_once(':')?;
-                Some((
-                    n.trim(),
-                    lo.trim().parse::<f64>().ok()?,
-                    hi.trim().parse::<f64>().ok()?,
-                ))
-            });
-            let (name, lo, hi) = parsed.with_context(|| {
-                format!(
-                    "--bounds {text}: write NAME=LO:HI, e.g. --bounds {}=0:5",
-                    kind.param_names()[0]
-                )
-            })?;
-            let i = kind
-                .param_index(name)
-                .map_err(|e| anyhow::anyhow!("--bounds: {e}"))?;
-            b[i] = (lo, hi);
-        }
+        let b = spec::bounds(
+            kind,
+            &a.bounds,
+            vec![(0.0, (hi - lo).max(f64::MIN_POSITIVE)); kind.dim()],
+        )?;
         req.bounds = Some(b);
     }
     let q = quantify(&op, &pv, &req).map_err(|e| anyhow::anyhow!("{}: {e}", a.file.display()))?;

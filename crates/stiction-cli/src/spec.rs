@@ -169,3 +169,32 @@ pub fn model(kind: ModelKind, params: &[String]) -> Result<Model> {
     kind.build(&values)
         .map_err(|e| anyhow::anyhow!("--param: {e}"))
 }
+
+/// `--bounds NAME=LO:HI` flags applied over default ranges (one per parameter of the model).
+pub fn bounds(
+    kind: ModelKind,
+    texts: &[String],
+    mut ranges: Vec<(f64, f64)>,
+) -> Result<Vec<(f64, f64)>> {
+    for text in texts {
+        let parsed = text.split_once('=').and_then(|(n, r)| {
+            let (lo, hi) = r.split_once(':')?;
+            Some((
+                n.trim(),
+                lo.trim().parse::<f64>().ok()?,
+                hi.trim().parse::<f64>().ok()?,
+            ))
+        });
+        let (name, lo, hi) = parsed.with_context(|| {
+            format!(
+                "--bounds {text}: write NAME=LO:HI, e.g. --bounds {}=0.01:10",
+                kind.param_names()[0]
+            )
+        })?;
+        let i = kind
+            .param_index(name)
+            .map_err(|e| anyhow::anyhow!("--bounds: {e}"))?;
+        ranges[i] = (lo, hi);
+    }
+    Ok(ranges)
+}

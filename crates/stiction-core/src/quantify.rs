@@ -14,7 +14,7 @@
 
 use crate::estimate::solver::{self, CostFunction, Evaluator};
 use crate::estimate::{
-    aco, acor, exact, AcoSettings, AcorSettings, EstimateError, GridSettings, Method,
+    self, aco, acor, exact, AcoSettings, AcorSettings, EstimateError, GridSettings, Method,
 };
 use crate::identify::{self, Data, Fit, SearchRange, Structure};
 use crate::models::ModelKind;
@@ -271,20 +271,7 @@ pub fn quantify(
 ) -> Result<Quantification, EstimateError> {
     let started = Instant::now();
     let n = op.len();
-    if pv.len() != n {
-        return Err(EstimateError::Data(format!(
-            "op has {n} samples but pv has {}",
-            pv.len()
-        )));
-    }
-    for (name, s) in [("op", op), ("pv", pv)] {
-        if let Some(i) = s.iter().position(|v| !v.is_finite()) {
-            return Err(EstimateError::Data(format!(
-                "{name} sample {i} is {}; every value must be a finite number",
-                s[i]
-            )));
-        }
-    }
+    estimate::check_pair(("op", op), ("pv", pv))?;
     if !(req.ts > 0.0 && req.ts.is_finite()) {
         return Err(EstimateError::Settings(format!(
             "the sampling time must be a positive number of seconds, got {}",
@@ -330,33 +317,7 @@ pub fn quantify(
         Some(b) => b.clone(),
         None => vec![(0.0, op_range); req.model.dim()],
     };
-    if bounds.len() != req.model.dim() {
-        return Err(EstimateError::Settings(format!(
-            "model {} has {} parameters but {} bounds were given",
-            req.model,
-            req.model.dim(),
-            bounds.len()
-        )));
-    }
-    for (spec, &(lo, hi)) in req.model.params().iter().zip(&bounds) {
-        let err = |why| EstimateError::Bounds {
-            name: spec.name.into(),
-            lo,
-            hi,
-            why,
-        };
-        if !lo.is_finite() || !hi.is_finite() {
-            return Err(err("both ends must be finite numbers"));
-        }
-        if lo < 0.0 {
-            return Err(err("the lower end must not be negative"));
-        }
-        if lo >= hi {
-            return Err(err(
-                "the lower end must be below the upper end (reversed or empty)",
-            ));
-        }
-    }
+    estimate::check_bounds(req.model, &bounds)?;
 
     let data = Data::new(pv, search.t0());
     let mut evaluations = 0u64;
@@ -696,6 +657,9 @@ fn pilot_points(kind: ModelKind, bounds: &[(f64, f64)]) -> Vec<Vec<f64>> {
     }
 }
 
+/// A cell of the d-partition with its cost under each structure.
+type CellCosts = ((f64, f64), Vec<f64>);
+
 /// Stenman, exact: every distinct valve trajectory (cell of the partition of the d-range) is
 /// simulated once and fitted with each of the given linear structures. The range is cut into fixed
 /// chunks walked in parallel, so the work spreads over threads and the result does not depend on
@@ -744,7 +708,7 @@ fn exact_stenman(problems: &[Hammerstein], (lo, hi): (f64, f64), full: bool) -> 
     // slip both make), so each walk keeps the least-squares sums of its previous cell and updates
     // only the rows that see a changed sample; a full recomputation now and then bounds rounding.
     const FULL_EVERY: usize = 256;
-    let per_chunk: Vec<Vec<((f64, f64), Vec<f64>)>> = chunks
+    let per_chunk: Vec<Vec<CellCosts>> = chunks
         .par_iter()
         .map_init(
             || (vec![0.0; n], vec![0.0; n], Vec::new(), Vec::new()),
@@ -789,7 +753,7 @@ fn exact_stenman(problems: &[Hammerstein], (lo, hi): (f64, f64), full: bool) -> 
             },
         )
         .collect();
-    let cells: Vec<((f64, f64), Vec<f64>)> = per_chunk.into_iter().flatten().collect();
+    let cells: Vec<CellCosts> = per_chunk.into_iter().flatten().collect();
     (0..problems.len())
         .map(|s| {
             let best = cells.iter().map(|c| c.1[s]).fold(f64::INFINITY, f64::min);

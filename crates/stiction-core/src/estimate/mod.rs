@@ -147,25 +147,7 @@ impl Request {
                 bounds.len()
             )));
         }
-        for (spec, &(lo, hi)) in specs.iter().zip(&bounds) {
-            let err = |why| EstimateError::Bounds {
-                name: spec.name.to_string(),
-                lo,
-                hi,
-                why,
-            };
-            if !lo.is_finite() || !hi.is_finite() {
-                return Err(err("both ends must be finite numbers"));
-            }
-            if lo < spec.min {
-                return Err(err("the lower end must not be negative"));
-            }
-            if lo >= hi {
-                return Err(err(
-                    "the lower end must be below the upper end (reversed or empty)",
-                ));
-            }
-        }
+        check_bounds(self.model, &bounds)?;
         Ok(bounds)
     }
 
@@ -267,26 +249,12 @@ pub struct Certificate {
 
 /// Check the data an estimation needs: equal lengths, finite values, enough samples, a moving command.
 pub fn check_data(op: &[f64], mv: &[f64]) -> Result<(), EstimateError> {
-    if op.len() != mv.len() {
-        return Err(EstimateError::Data(format!(
-            "op has {} samples but mv has {}",
-            op.len(),
-            mv.len()
-        )));
-    }
+    check_pair(("op", op), ("mv", mv))?;
     if op.len() < MIN_SAMPLES {
         return Err(EstimateError::Data(format!(
             "only {} samples; at least {MIN_SAMPLES} are needed",
             op.len()
         )));
-    }
-    for (name, s) in [("op", op), ("mv", mv)] {
-        if let Some(i) = s.iter().position(|v| !v.is_finite()) {
-            return Err(EstimateError::Data(format!(
-                "{name} sample {i} is {}; every value must be a finite number",
-                s[i]
-            )));
-        }
     }
     let (lo, hi) = op
         .iter()
@@ -297,6 +265,61 @@ pub fn check_data(op: &[f64], mv: &[f64]) -> Result<(), EstimateError> {
         return Err(EstimateError::Data(format!(
             "the command op is constant ({lo}); a valve that is never moved shows no stiction"
         )));
+    }
+    Ok(())
+}
+
+/// Two series of the same length holding only finite numbers.
+pub fn check_pair(
+    (a_name, a): (&str, &[f64]),
+    (b_name, b): (&str, &[f64]),
+) -> Result<(), EstimateError> {
+    if a.len() != b.len() {
+        return Err(EstimateError::Data(format!(
+            "{a_name} has {} samples but {b_name} has {}",
+            a.len(),
+            b.len()
+        )));
+    }
+    for (name, s) in [(a_name, a), (b_name, b)] {
+        if let Some(i) = s.iter().position(|v| !v.is_finite()) {
+            return Err(EstimateError::Data(format!(
+                "{name} sample {i} is {}; every value must be a finite number",
+                s[i]
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Search ranges, one per parameter: finite, not below the parameter's minimum, not reversed.
+pub fn check_bounds(model: ModelKind, bounds: &[(f64, f64)]) -> Result<(), EstimateError> {
+    let specs = model.params();
+    if bounds.len() != specs.len() {
+        return Err(EstimateError::Settings(format!(
+            "model {model} has {} parameters but {} bounds were given",
+            specs.len(),
+            bounds.len()
+        )));
+    }
+    for (spec, &(lo, hi)) in specs.iter().zip(bounds) {
+        let err = |why| EstimateError::Bounds {
+            name: spec.name.to_string(),
+            lo,
+            hi,
+            why,
+        };
+        if !lo.is_finite() || !hi.is_finite() {
+            return Err(err("both ends must be finite numbers"));
+        }
+        if lo < spec.min {
+            return Err(err("the lower end must not be negative"));
+        }
+        if lo >= hi {
+            return Err(err(
+                "the lower end must be below the upper end (reversed or empty)",
+            ));
+        }
     }
     Ok(())
 }
