@@ -434,11 +434,11 @@ pub fn quantify(
             let mv_c = problem.valve(&outcome.best);
             tried.push((problem.prepared.structure(), outcome, criterion));
             evaluations += 1;
-            // confirm the structure at this answer; a different one is searched next round
+            // confirm the structure at this answer; a different one is searched next, first
             if let Some(next) = identify::select(&data, &mv_c, &search) {
                 if !tried.iter().any(|t| t.0 == next.structure) && !queue.contains(&next.structure)
                 {
-                    queue.push_back(next.structure);
+                    queue.push_front(next.structure);
                 }
             }
         }
