@@ -618,8 +618,8 @@ fn polish(
 }
 
 /// Structures from the pilots that are searched first, and the most searched in all.
-const STARTING_STRUCTURES: usize = 3;
-const MOST_STRUCTURES: usize = 5;
+const STARTING_STRUCTURES: usize = 4;
+const MOST_STRUCTURES: usize = 8;
 
 struct Outcome {
     best: Vec<f64>,
