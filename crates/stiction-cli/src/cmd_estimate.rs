@@ -21,18 +21,8 @@ pub struct Args {
     /// Column of time [default: the first of t, time, timestamp, if any]
     #[arg(long)]
     time: Option<String>,
-    /// Stiction model: stenman, he, kano, choudhury
-    #[arg(long, default_value = "stenman")]
-    model: String,
-    /// aco (the paper's), aco-r, exact (stenman only), grid [default: exact for stenman, else aco-r]
-    #[arg(long)]
-    method: Option<String>,
-    /// Seed of the random methods
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Print one JSON object instead of text
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    fit: spec::FitArgs,
     /// Write the best parameters and fit error per iteration to this CSV (aco, aco-r)
     #[arg(long)]
     trace: Option<PathBuf>,
@@ -87,15 +77,9 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<()> {
-    let kind = spec::model_kind(&a.model)?;
-    let method = match &a.method {
-        Some(m) => m
-            .parse::<Method>()
-            .map_err(|e| anyhow::anyhow!("--method: {e}"))?,
-        None => Method::default_for(kind),
-    };
+    let (kind, method) = a.fit.resolve()?;
     let mut req = Request::new(kind, method);
-    req.seed = a.seed;
+    req.seed = a.fit.seed;
     req.trace = a.trace.is_some();
     req.bounds = bounds(kind, &a)?;
     req.aco.ants = a.ants.unwrap_or(req.aco.ants);
@@ -134,7 +118,7 @@ pub fn run(a: Args) -> Result<()> {
     if let Some(path) = &a.trace {
         write_trace(path, kind, &est)?;
     }
-    if a.json {
+    if a.fit.json {
         println!("{}", serde_json::to_string_pretty(&est)?);
     } else {
         print_human(&a.file.display().to_string(), &est);

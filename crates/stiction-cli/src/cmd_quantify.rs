@@ -2,7 +2,6 @@ use crate::plot::{self, Chart, Kind, Series};
 use crate::{data, spec};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
-use stiction_core::estimate::Method;
 use stiction_core::quantify::{quantify, Quantification, QuantifyRequest};
 
 #[derive(clap::Args)]
@@ -25,18 +24,8 @@ pub struct Args {
     /// Sampling time in seconds [default: from the time column, else 1]
     #[arg(long)]
     ts: Option<f64>,
-    /// Stiction model: stenman, he, kano, choudhury
-    #[arg(long, default_value = "stenman")]
-    model: String,
-    /// exact (stenman only), aco, aco-r, grid [default: exact for stenman, else aco-r]
-    #[arg(long)]
-    method: Option<String>,
-    /// Seed of the random methods
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Print one JSON object instead of text
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    fit: spec::FitArgs,
     /// Write the PV-OP phase plot with the fitted model and the trends (PNG and SVG) to this folder
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -67,16 +56,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<()> {
-    let kind = spec::model_kind(&a.model)?;
-    let method = match &a.method {
-        Some(m) => m
-            .parse::<Method>()
-            .map_err(|e| anyhow::anyhow!("--method: {e}"))?,
-        None => Method::default_for(kind),
-    };
-    if method == Method::Exact && kind != stiction_core::ModelKind::Stenman {
-        bail!("--method exact solves the Stenman model only; for {kind} use aco-r, aco or grid");
-    }
+    let (kind, method) = a.fit.resolve()?;
     if let Some(ts) = a.ts {
         if !(ts > 0.0 && ts.is_finite()) {
             bail!("--ts {ts}: the sampling time must be a positive number of seconds");
@@ -103,7 +83,7 @@ pub fn run(a: Args) -> Result<()> {
 
     let mut req = QuantifyRequest::new(kind, method);
     req.ts = ts;
-    req.seed = a.seed;
+    req.seed = a.fit.seed;
     req.max_delay = a.max_delay;
     req.full_partition = !a.quick;
     req.integrating = if a.integrating {
@@ -146,7 +126,7 @@ pub fn run(a: Args) -> Result<()> {
             plots(&q, &t, &op, &pv, dir)?;
         }
     }
-    if a.json {
+    if a.fit.json {
         println!("{}", serde_json::to_string_pretty(&q)?);
         return Ok(());
     }

@@ -198,3 +198,39 @@ pub fn bounds(
     }
     Ok(ranges)
 }
+
+/// Flags every estimating command shares: which model, which method, the seed, JSON output.
+#[derive(clap::Args)]
+pub struct FitArgs {
+    /// Stiction model: stenman, he, kano, choudhury
+    #[arg(long, default_value = "stenman")]
+    pub model: String,
+    /// aco (the paper's), aco-r, exact (stenman only), grid [default: exact for stenman, else aco-r]
+    #[arg(long)]
+    pub method: Option<String>,
+    /// Seed of the random methods
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print one JSON object instead of text
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl FitArgs {
+    /// The model and method, checked (exact is for Stenman only).
+    pub fn resolve(&self) -> Result<(ModelKind, stiction_core::Method)> {
+        let kind = model_kind(&self.model)?;
+        let method = match &self.method {
+            Some(m) => m
+                .parse::<stiction_core::Method>()
+                .map_err(|e| anyhow::anyhow!("--method: {e}"))?,
+            None => stiction_core::Method::default_for(kind),
+        };
+        if method == stiction_core::Method::Exact && kind != ModelKind::Stenman {
+            bail!(
+                "--method exact solves the Stenman model only; for {kind} use aco-r, aco or grid"
+            );
+        }
+        Ok((kind, method))
+    }
+}
