@@ -711,7 +711,7 @@ fn exact_stenman(problems: &[Hammerstein], (lo, hi): (f64, f64), full: bool) -> 
     let per_chunk: Vec<Vec<CellCosts>> = chunks
         .par_iter()
         .map_init(
-            || (vec![0.0; n], vec![0.0; n], Vec::new(), Vec::new()),
+            || (vec![0.0f64; n], vec![0.0f64; n], Vec::new(), Vec::new()),
             |(mv, prev, changed, rows), &chunk| {
                 let mut out = Vec::new();
                 let mut bounds = start_bounds.clone();
@@ -722,7 +722,21 @@ fn exact_stenman(problems: &[Hammerstein], (lo, hi): (f64, f64), full: bool) -> 
                     }
                     changed.clear();
                     if !sums.is_empty() && out.len() % FULL_EVERY != 0 {
-                        changed.extend((0..n).filter(|&i| mv[i] != prev[i]));
+                        // compare blocks of samples bit for bit; most blocks are unchanged
+                        for (blk, (m, p)) in mv.chunks(16).zip(prev.chunks(16)).enumerate() {
+                            let differs = m
+                                .iter()
+                                .zip(p)
+                                .fold(0u64, |acc, (x, y)| acc | (x.to_bits() ^ y.to_bits()));
+                            if differs != 0 {
+                                let base = blk * 16;
+                                changed.extend(
+                                    (0..m.len())
+                                        .filter(|&i| m[i].to_bits() != p[i].to_bits())
+                                        .map(|i| base + i),
+                                );
+                            }
+                        }
                     }
                     let incremental =
                         !sums.is_empty() && out.len() % FULL_EVERY != 0 && changed.len() < n / 8;

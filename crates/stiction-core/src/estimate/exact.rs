@@ -239,18 +239,20 @@ pub fn stenman_cells(op: &[f64], lo: f64, hi: f64) -> Vec<(f64, f64)> {
 /// trajectory driven by `op` is the same as d's, clipped to `[lo, hi)`. One pass over the data:
 /// the trajectory stays the same while every sticking step keeps `|u - x| <= d` and every slip
 /// keeps `|u - x| > d`. The trajectory itself is written to `mv`.
+// kept out of line: inlined into the walk, its loop variables were spilled to the stack
+#[inline(never)]
 pub fn stenman_cell_into(op: &[f64], d: f64, lo: f64, hi: f64, mv: &mut [f64]) -> (f64, f64) {
     let (mut a, mut b) = (lo, hi);
     let mut x = op[0];
     mv[0] = x;
     for (&u, m) in op[1..].iter().zip(&mut mv[1..]) {
         let delta = (u - x).abs();
-        if delta > d {
-            b = b.min(delta);
-            x = u;
-        } else {
-            a = a.max(delta);
-        }
+        let slips = delta > d;
+        // plain comparisons, not f64::min/max: the data are finite, and the NaN handling of
+        // min/max would sit on the loop-carried chains
+        b = if slips && delta < b { delta } else { b };
+        a = if !slips && delta > a { delta } else { a };
+        x = if slips { u } else { x };
         *m = x;
     }
     (a, b)
