@@ -68,7 +68,7 @@ pub fn run(a: Args) -> Result<()> {
     let time_col = data::time_column(&table, a.time.as_deref())?;
     let op = table.numbers(op_col)?;
     let pv = table.numbers(pv_col)?;
-    let time = time_col.map(|c| table.numbers(c)).transpose()?;
+    let time = time_col.map(|c| table.times(c)).transpose()?;
     let ts = match (a.ts, &time) {
         (Some(ts), _) => ts,
         (None, Some(t)) => sampling_time(t).with_context(|| {
@@ -120,7 +120,8 @@ pub fn run(a: Args) -> Result<()> {
     if let Some(dir) = &a.plot {
         if q.status == "ok" {
             let t: Vec<f64> = match &time {
-                Some(t) => t.clone(),
+                // seconds from the first sample (text timestamps are seconds since 1970)
+                Some(t) => t.iter().map(|v| v - t[0]).collect(),
                 None => (0..op.len()).map(|k| k as f64 * ts).collect(),
             };
             plots(&q, &t, &op, &pv, dir)?;

@@ -131,6 +131,33 @@ impl Table {
     }
 }
 
+impl Table {
+    /// Parse a time column: seconds as numbers, or text timestamps (ISO 8601, `YYYY-MM-DD HH:MM:SS`),
+    /// returned as seconds (text timestamps: since 1970).
+    pub fn times(&self, col: usize) -> Result<Vec<f64>> {
+        let name = &self.headers[col];
+        let file = self.path.display();
+        let mut out = Vec::with_capacity(self.rows.len());
+        for (i, row) in self.rows.iter().enumerate() {
+            let cell = &row[col];
+            let line = self.lines[i];
+            let v = cell
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .or_else(|| crate::timestamp::parse(cell));
+            match v {
+                Some(v) => out.push(v),
+                None => bail!(
+                    "{file}: line {line}, column '{name}': '{cell}' is neither a number of seconds nor a date and time \
+                     such as 2024-03-01 12:00:05 or 2024-03-01T12:00:05Z"
+                ),
+            }
+        }
+        Ok(out)
+    }
+}
+
 /// The delimiter the header line uses most: comma, semicolon or tab.
 fn sniff_delimiter(header: &str) -> u8 {
     [b',', b';', b'\t']

@@ -9,6 +9,7 @@ mod cmd_simulate;
 mod data;
 mod plot;
 mod spec;
+mod timestamp;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -635,3 +635,43 @@ fn quantify_bad_input_and_insufficient_data() {
     let v = json(&ok(&["quantify", &c, "--json"]));
     assert_eq!(v["status"], "insufficient_data");
 }
+
+#[test]
+fn quantify_reads_historian_timestamps() {
+    let dir = tmp();
+    let f = closed_loop(dir.path(), "1");
+    // the same loop exported with text timestamps every 2 s, semicolon separated
+    let text = std::fs::read_to_string(&f).unwrap();
+    let mut out = String::from("Timestamp;OP;PV\n");
+    for (k, line) in text.lines().skip(1).enumerate() {
+        let c: Vec<&str> = line.split(',').collect();
+        let secs = 2 * k;
+        out.push_str(&format!(
+            "2024-03-01 {:02}:{:02}:{:02};{};{}\n",
+            10 + secs / 3600,
+            (secs / 60) % 60,
+            secs % 60,
+            c[2],
+            c[4]
+        ));
+    }
+    let h = write(dir.path(), "historian.csv", &out);
+    let v = json(&ok(&["quantify", &h, "--json"]));
+    assert_eq!(v["ts"], 2.0);
+    assert_eq!(v["status"], "ok");
+    let bad = write(
+        dir.path(),
+        "badtime.csv",
+        &out.replacen("2024-03-01 10:00:04", "soon", 1),
+    );
+    fails(
+        &["quantify", &bad],
+        &[
+            "badtime.csv",
+            "line 4",
+            "'Timestamp'",
+            "'soon'",
+            "date and time",
+        ],
+    );
+}
