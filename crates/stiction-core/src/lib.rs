@@ -3,6 +3,7 @@
 //! Pure numerics: functions take slices and return serde-serialisable results; nothing here reads
 //! files, prints or plots. The command-line tool and every other front end share these results.
 
+pub mod detect;
 pub mod estimate;
 pub mod identify;
 pub mod models;

@@ -1,0 +1,211 @@
+//! Oscillation detection in routine loop data.
+//!
+//! - Regularity (Thornhill, Huang and Zhang 2003): the zero crossings of the autocorrelation
+//!   function of the (mean-free) control error give the oscillation period; with Tp the periods
+//!   from successive pairs of crossings, `r = mean(Tp) / (3 std(Tp))`, and `r > 1` means a regular
+//!   oscillation.
+//! - IAE count (Hägglund 1995): the integrated absolute error between successive zero crossings of
+//!   the control error; a half period whose IAE exceeds `2 a / ω` (that of a sine of amplitude `a`)
+//!   is a load disturbance; `n_lim` of them within a supervision window mean an oscillation.
+
+use serde::{Deserialize, Serialize};
+
+/// Thornhill's regularity of an oscillation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Regularity {
+    /// Mean period, seconds (`None` with fewer than 3 zero crossings of the autocorrelation).
+    pub period: Option<f64>,
+    /// r = mean(Tp) / (3 std(Tp)); infinite for perfectly regular periods.
+    pub regularity: f64,
+    /// The threshold: r above it means a regular oscillation.
+    pub threshold: f64,
+    pub zero_crossings: usize,
+    pub oscillating: bool,
+}
+
+/// Default threshold on Thornhill's r.
+pub const REGULARITY_THRESHOLD: f64 = 1.0;
+
+/// Autocorrelation of a mean-free copy of `x` for lags `0..=max_lag` (biased estimator, so r(0) = 1).
+pub fn autocorrelation(x: &[f64], max_lag: usize) -> Vec<f64> {
+    let n = x.len();
+    let mean = x.iter().sum::<f64>() / n.max(1) as f64;
+    let c: Vec<f64> = x.iter().map(|v| v - mean).collect();
+    let var: f64 = c.iter().map(|v| v * v).sum();
+    if var <= 0.0 {
+        return vec![0.0; max_lag.min(n.saturating_sub(1)) + 1];
+    }
+    (0..=max_lag.min(n.saturating_sub(1)))
+        .map(|k| {
+            c[..n - k]
+                .iter()
+                .zip(&c[k..])
+                .map(|(a, b)| a * b)
+                .sum::<f64>()
+                / var
+        })
+        .collect()
+}
+
+/// Regularity of the oscillation in `error` sampled every `ts` seconds.
+pub fn regularity(error: &[f64], ts: f64) -> Regularity {
+    let acf = autocorrelation(error, error.len() / 2);
+    // zero crossings, interpolated between lags
+    let mut crossings = Vec::new();
+    for k in 1..acf.len() {
+        let (a, b) = (acf[k - 1], acf[k]);
+        if (a > 0.0 && b <= 0.0) || (a < 0.0 && b >= 0.0) {
+            let frac = if a != b { a / (a - b) } else { 0.0 };
+            crossings.push((k - 1) as f64 + frac);
+        }
+    }
+    // each pair of crossings two apart spans one period
+    let periods: Vec<f64> = crossings.windows(3).map(|w| (w[2] - w[0]) * ts).collect();
+    let (period, r) = if periods.is_empty() {
+        (None, 0.0)
+    } else {
+        let m = periods.iter().sum::<f64>() / periods.len() as f64;
+        let sd =
+            (periods.iter().map(|p| (p - m) * (p - m)).sum::<f64>() / periods.len() as f64).sqrt();
+        let r = if sd > 0.0 {
+            m / (3.0 * sd)
+        } else {
+            f64::INFINITY
+        };
+        (Some(m), r)
+    };
+    Regularity {
+        period,
+        regularity: r,
+        threshold: REGULARITY_THRESHOLD,
+        zero_crossings: crossings.len(),
+        oscillating: periods.len() >= 2 && r > REGULARITY_THRESHOLD,
+    }
+}
+
+/// Hägglund's load-disturbance count.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IaeCount {
+    /// Half periods whose IAE exceeded the limit, over the whole record.
+    pub exceedances: usize,
+    /// The largest number within any supervision window.
+    pub most_in_window: usize,
+    /// The IAE limit 2 a / ω used, in error units x seconds.
+    pub iae_limit: f64,
+    pub n_lim: usize,
+    pub window: f64,
+    pub oscillating: bool,
+}
+
+/// Settings of the IAE count: acceptable amplitude `a`, the frequency scale `omega` (rad/s: the
+/// ultimate frequency, or 2π over the period when it is unknown), `n_lim` exceedances within a
+/// supervision window of `window` seconds.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct IaeSettings {
+    pub amplitude: f64,
+    pub omega: f64,
+    pub n_lim: usize,
+    pub window: f64,
+}
+
+pub fn iae_count(error: &[f64], ts: f64, s: &IaeSettings) -> IaeCount {
+    let limit = 2.0 * s.amplitude / s.omega;
+    let mean = error.iter().sum::<f64>() / error.len().max(1) as f64;
+    let mut ends = Vec::new(); // time of each exceeding half period's end
+    let mut iae = 0.0;
+    let mut sign = 0.0f64;
+    for (k, &e) in error.iter().enumerate() {
+        let v = e - mean;
+        let sv = v.signum();
+        if sign != 0.0 && sv != sign && v != 0.0 {
+            if iae > limit {
+                ends.push(k as f64 * ts);
+            }
+            iae = 0.0;
+        }
+        if v != 0.0 {
+            sign = sv;
+        }
+        iae += v.abs() * ts;
+    }
+    let mut most = 0;
+    let mut first = 0;
+    for (i, &t) in ends.iter().enumerate() {
+        while t - ends[first] > s.window {
+            first += 1;
+        }
+        most = most.max(i + 1 - first);
+    }
+    IaeCount {
+        exceedances: ends.len(),
+        most_in_window: most,
+        iae_limit: limit,
+        n_lim: s.n_lim,
+        window: s.window,
+        oscillating: most >= s.n_lim,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::{gaussian, seeded};
+
+    fn sine(n: usize, period: f64, ts: f64, noise: f64) -> Vec<f64> {
+        let mut rng = seeded(3);
+        (0..n)
+            .map(|k| {
+                (std::f64::consts::TAU * k as f64 * ts / period).sin() + noise * gaussian(&mut rng)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_noisy_sine_is_a_regular_oscillation_with_its_period() {
+        let r = regularity(&sine(2000, 50.0, 1.0, 0.3), 1.0);
+        assert!(r.oscillating, "{r:?}");
+        assert!((r.period.unwrap() - 50.0).abs() < 2.0, "{r:?}");
+    }
+
+    #[test]
+    fn white_noise_is_not() {
+        let mut rng = seeded(5);
+        let noise: Vec<f64> = (0..2000).map(|_| gaussian(&mut rng)).collect();
+        let r = regularity(&noise, 1.0);
+        assert!(!r.oscillating, "{r:?}");
+        let c = iae_count(
+            &noise,
+            1.0,
+            &IaeSettings {
+                amplitude: 0.5,
+                omega: std::f64::consts::TAU / 50.0,
+                n_lim: 10,
+                window: 2500.0,
+            },
+        );
+        assert!(!c.oscillating, "{c:?}");
+    }
+
+    #[test]
+    fn iae_count_sees_every_half_period_of_a_large_oscillation() {
+        let e = sine(2000, 50.0, 1.0, 0.0);
+        let s = IaeSettings {
+            amplitude: 0.1,
+            omega: std::f64::consts::TAU / 50.0,
+            n_lim: 10,
+            window: 2500.0,
+        };
+        let c = iae_count(&e, 1.0, &s);
+        // 2000 s / 25 s half periods, less the unfinished first and last
+        assert!((77..=80).contains(&c.exceedances), "{c:?}");
+        assert!(c.oscillating);
+        // an oscillation smaller than the acceptable amplitude raises no alarm
+        let small: Vec<f64> = e.iter().map(|v| 0.05 * v).collect();
+        assert_eq!(iae_count(&small, 1.0, &s).exceedances, 0);
+    }
+
+    #[test]
+    fn autocorrelation_of_a_constant_is_zero_not_nan() {
+        assert!(autocorrelation(&[2.0; 20], 5).iter().all(|&v| v == 0.0));
+    }
+}
