@@ -146,6 +146,97 @@ pub fn iae_count(error: &[f64], ts: f64, s: &IaeSettings) -> IaeCount {
     }
 }
 
+/// Horch's cross-correlation test (self-regulating loops).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CrossCorrelation {
+    /// First zero crossings of the OP-PV cross-correlation on the negative and positive lag side,
+    /// seconds.
+    pub tau_left: Option<f64>,
+    pub tau_right: Option<f64>,
+    /// |τr + τl| / (τr - τl): 0 for an even function (extremum at lag 0), 1 for an odd one (zero
+    /// at lag 0).
+    pub oddness: Option<f64>,
+    /// Odd (stiction) above `stiction_above`, even (no stiction) below `no_stiction_below`.
+    pub stiction_above: f64,
+    pub no_stiction_below: f64,
+    /// "stiction", "no_stiction" or "undetermined".
+    pub vote: String,
+}
+
+/// Cross-correlation of `op` with `pv` at lags `-max_lag..=max_lag` (index `max_lag` is lag 0;
+/// positive lags: pv after op).
+pub fn cross_correlation(op: &[f64], pv: &[f64], max_lag: usize) -> Vec<f64> {
+    let n = op.len().min(pv.len());
+    let mean = |v: &[f64]| v[..n].iter().sum::<f64>() / n.max(1) as f64;
+    let (mu, my) = (mean(op), mean(pv));
+    let u: Vec<f64> = op[..n].iter().map(|v| v - mu).collect();
+    let y: Vec<f64> = pv[..n].iter().map(|v| v - my).collect();
+    let norm = (u.iter().map(|v| v * v).sum::<f64>() * y.iter().map(|v| v * v).sum::<f64>()).sqrt();
+    let lag = max_lag.min(n.saturating_sub(1));
+    (0..=2 * lag)
+        .map(|i| {
+            let k = i as isize - lag as isize;
+            if norm <= 0.0 {
+                return 0.0;
+            }
+            let sum: f64 = if k >= 0 {
+                u[..n - k as usize]
+                    .iter()
+                    .zip(&y[k as usize..])
+                    .map(|(a, b)| a * b)
+                    .sum()
+            } else {
+                y[..n - (-k) as usize]
+                    .iter()
+                    .zip(&u[(-k) as usize..])
+                    .map(|(a, b)| a * b)
+                    .sum()
+            };
+            sum / norm
+        })
+        .collect()
+}
+
+/// Horch's test: the OP-PV cross-correlation is odd for a sticky valve in a self-regulating loop
+/// and even otherwise. `max_lag` in samples should cover at least half an oscillation period.
+pub fn horch(op: &[f64], pv: &[f64], ts: f64, max_lag: usize) -> CrossCorrelation {
+    let ccf = cross_correlation(op, pv, max_lag);
+    let mid = (ccf.len() - 1) / 2;
+    let crossing = |range: Box<dyn Iterator<Item = usize>>, step: isize| {
+        for i in range {
+            let j = (i as isize + step) as usize;
+            let (a, b) = (ccf[i], ccf[j]);
+            if a == 0.0 {
+                return Some(i as f64);
+            }
+            if (a > 0.0) != (b > 0.0) {
+                return Some(i as f64 + step as f64 * a / (a - b));
+            }
+        }
+        None
+    };
+    let right = crossing(Box::new(mid..ccf.len() - 1), 1).map(|i| (i - mid as f64) * ts);
+    let left = crossing(Box::new((1..=mid).rev()), -1).map(|i| (i - mid as f64) * ts);
+    let oddness = match (left, right) {
+        (Some(l), Some(r)) if r - l > 0.0 => Some(((r + l) / (r - l)).abs()),
+        _ => None,
+    };
+    let (hi, lo) = (2.0 / 3.0, 1.0 / 3.0);
+    let vote = match oddness {
+        Some(o) if o > hi => "stiction",
+        Some(o) if o < lo => "no_stiction",
+        _ => "undetermined",
+    };
+    CrossCorrelation {
+        tau_left: left,
+        tau_right: right,
+        oddness,
+        stiction_above: hi,
+        no_stiction_below: lo,
+        vote: vote.into(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -202,6 +293,22 @@ mod tests {
         // an oscillation smaller than the acceptable amplitude raises no alarm
         let small: Vec<f64> = e.iter().map(|v| 0.05 * v).collect();
         assert_eq!(iae_count(&small, 1.0, &s).exceedances, 0);
+    }
+
+    #[test]
+    fn horch_tells_odd_from_even() {
+        let n = 2000;
+        let w = std::f64::consts::TAU / 50.0;
+        let op: Vec<f64> = (0..n).map(|k| (w * k as f64).sin()).collect();
+        // PV a quarter period behind OP (integrating-like shape of a stick-slip cycle): odd
+        let lagged: Vec<f64> = (0..n).map(|k| -(w * k as f64).cos()).collect();
+        let odd = horch(&op, &lagged, 1.0, 60);
+        assert_eq!(odd.vote, "stiction", "{odd:?}");
+        // PV in antiphase with OP (a linear loop under a disturbance): even
+        let anti: Vec<f64> = op.iter().map(|v| -v).collect();
+        let even = horch(&op, &anti, 1.0, 60);
+        assert_eq!(even.vote, "no_stiction", "{even:?}");
+        assert!((even.tau_right.unwrap() - 12.5).abs() < 0.5, "{even:?}");
     }
 
     #[test]
