@@ -322,8 +322,9 @@ fn report(rows: &[Row], total: f64, seeds: usize) -> String {
          as we have for d, is the fix; it is not built yet.\n\
          - **Stenman, noise-free.** With no noise several (structure, d) pairs reproduce the PV to rounding \
          (the criterion's floor is 1e-10 of the PV variance), and a neighbouring cell with an integrating or \
-         higher-order structure can win (e.g. d = 0.53 with delay 10 instead of 0.50 with delay 11). One case \
-         (K=2 τ=5 θ=2) chose a wrong delay at the start and never left it.\n\
+         higher-order structure can win (e.g. d = 0.53 with delay 10 instead of 0.50 with delay 11); in the \
+         other miss (d = 4 on K=1 τ=30 θ=5, 5.2 %) a delay of 4 samples with two input terms stood in for the \
+         true 6.\n\
          - **Limit cycles.** One PI tuning per process is used for every valve; the column 'limit cycle' says \
          whether the noise-free loop still oscillates in its second half. Loops that settle (no limit cycle) \
          carry little information about the band.\n"
