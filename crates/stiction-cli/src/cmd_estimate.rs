@@ -107,12 +107,9 @@ pub fn run(a: Args) -> Result<()> {
         &a.file,
         (&a.op, "--op", "controller output op"),
         (&a.mv, "--mv", "valve position mv"),
+        a.time.as_deref(),
         estimate::MIN_SAMPLES,
     )?;
-    if let Some(name) = &a.time {
-        let table = data::Table::read(&a.file)?;
-        data::time_column(&table, Some(name))?;
-    }
     let est = estimate::estimate(&op, &mv, &req)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.file.display()))?;
     if let Some(path) = &a.trace {

@@ -177,15 +177,24 @@ pub fn time_column(table: &Table, explicit: Option<&str>) -> Result<Option<usize
 }
 
 /// Read two columns (e.g. op and mv) ready for estimation, with the checks that apply to both.
+/// A time column named with `--time` must exist and parse, though estimation does not use it.
 pub fn read_pair(
     path: &Path,
     (a_name, a_flag, a_role): (&str, &str, &str),
     (b_name, b_flag, b_role): (&str, &str, &str),
+    time: Option<&str>,
     min_samples: usize,
 ) -> Result<(Vec<f64>, Vec<f64>)> {
     let table = Table::read(path)?;
     let a = table.require(a_name, a_flag, a_role)?;
     let b = table.require(b_name, b_flag, b_role)?;
+    if let Some(col) = time
+        .map(|name| time_column(&table, Some(name)))
+        .transpose()?
+        .flatten()
+    {
+        table.times(col)?;
+    }
     if table.len() < min_samples {
         bail!(
             "{}: only {} rows of data; estimation needs at least {min_samples} samples",
