@@ -7,6 +7,7 @@ pub mod detect;
 pub mod estimate;
 pub mod identify;
 pub mod models;
+pub mod quality;
 pub mod quantify;
 pub mod reproduce;
 pub mod rng;

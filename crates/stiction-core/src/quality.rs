@@ -1,0 +1,266 @@
+//! Data-quality gates: before any verdict on a loop, check the record can carry one. A failed gate
+//! means "insufficient data: <reason>", never a false "no stiction".
+
+use serde::{Deserialize, Serialize};
+
+/// One gate's finding.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Finding {
+    pub gate: String,
+    pub passed: bool,
+    /// The measured quantity and the limit it is held to.
+    pub value: f64,
+    pub limit: f64,
+    pub message: String,
+}
+
+/// Limits of the gates (named, documented conventions).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Limits {
+    /// Largest share of samples with OP at 0 % or 100 % (or pinned at its own extreme).
+    pub saturated_share: f64,
+    /// Largest share of samples whose PV repeats the previous value exactly (frozen or compressed).
+    pub repeated_share: f64,
+    /// Fewest distinct PV levels per 100 samples, below which the PV counts as quantised.
+    pub levels_per_100: f64,
+    /// Largest share of samples in manual mode.
+    pub manual_share: f64,
+    /// Largest step of the time axis, in sampling times, before it counts as a gap.
+    pub gap_steps: f64,
+    /// Largest number of setpoint changes.
+    pub setpoint_changes: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self {
+            saturated_share: 0.05,
+            repeated_share: 0.5,
+            levels_per_100: 5.0,
+            manual_share: 0.0,
+            gap_steps: 3.0,
+            setpoint_changes: 0,
+        }
+    }
+}
+
+/// The signals a loop record may have.
+pub struct Record<'a> {
+    pub op: &'a [f64],
+    pub pv: &'a [f64],
+    pub sp: Option<&'a [f64]>,
+    /// Seconds, one per sample.
+    pub time: Option<&'a [f64]>,
+    /// `true` where the controller is in automatic.
+    pub auto: Option<&'a [bool]>,
+}
+
+fn finding(gate: &str, passed: bool, value: f64, limit: f64, message: String) -> Finding {
+    Finding {
+        gate: gate.into(),
+        passed,
+        value,
+        limit,
+        message,
+    }
+}
+
+/// Run every gate that the record's signals allow.
+pub fn check(r: &Record, limits: &Limits) -> Vec<Finding> {
+    let n = r.op.len().max(1) as f64;
+    let mut out = Vec::new();
+
+    let (lo, hi) =
+        r.op.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+    let at_limit =
+        r.op.iter()
+            .filter(|&&v| v <= 0.0 || v >= 100.0 || (hi > lo && (v == lo || v == hi)))
+            .count();
+    // a few samples at the record's own extremes are normal; long stretches there are not
+    let share = if hi > lo {
+        at_limit.saturating_sub(2) as f64 / n
+    } else {
+        1.0
+    };
+    out.push(finding(
+        "op_saturated",
+        share <= limits.saturated_share,
+        share,
+        limits.saturated_share,
+        format!(
+            "OP is at a limit (0 %, 100 % or pinned at its extreme) in {:.0} % of the samples",
+            100.0 * share
+        ),
+    ));
+
+    let repeats = r.pv.windows(2).filter(|w| w[1] == w[0]).count() as f64 / (n - 1.0).max(1.0);
+    out.push(finding(
+        "pv_frozen",
+        repeats <= limits.repeated_share,
+        repeats,
+        limits.repeated_share,
+        format!(
+            "PV repeats its previous value in {:.0} % of the samples (frozen or compressed by the historian)",
+            100.0 * repeats
+        ),
+    ));
+
+    let mut levels: Vec<u64> = r.pv.iter().map(|v| v.to_bits()).collect();
+    levels.sort_unstable();
+    levels.dedup();
+    let per_100 = 100.0 * levels.len() as f64 / n;
+    out.push(finding(
+        "pv_quantised",
+        // fifty levels are enough to see a shape, however long the record
+        per_100 >= limits.levels_per_100 || levels.len() >= 50,
+        levels.len() as f64,
+        limits.levels_per_100,
+        format!("PV takes {} distinct values", levels.len()),
+    ));
+
+    if let Some(auto) = r.auto {
+        let manual = auto.iter().filter(|&&a| !a).count() as f64 / n;
+        out.push(finding(
+            "manual_mode",
+            manual <= limits.manual_share,
+            manual,
+            limits.manual_share,
+            format!(
+                "the loop is in manual in {:.0} % of the samples",
+                100.0 * manual
+            ),
+        ));
+    }
+
+    if let Some(sp) = r.sp {
+        let changes = sp.windows(2).filter(|w| w[1] != w[0]).count();
+        out.push(finding(
+            "setpoint_changes",
+            changes <= limits.setpoint_changes,
+            changes as f64,
+            limits.setpoint_changes as f64,
+            format!("the setpoint changes {changes} times"),
+        ));
+    }
+
+    if let Some(t) = r.time {
+        let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+        let backwards = steps.iter().filter(|&&s| s <= 0.0).count();
+        steps.sort_by(f64::total_cmp);
+        let ts = steps.get(steps.len() / 2).copied().unwrap_or(0.0);
+        let gaps = if ts > 0.0 {
+            t.windows(2)
+                .filter(|w| w[1] - w[0] > limits.gap_steps * ts)
+                .count()
+        } else {
+            0
+        };
+        out.push(finding(
+            "time_gaps",
+            gaps == 0 && backwards == 0 && ts > 0.0,
+            gaps as f64,
+            0.0,
+            format!(
+                "{gaps} gaps longer than {} sampling times, {backwards} steps where time does not increase",
+                limits.gap_steps
+            ),
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn loop_record(n: usize) -> (Vec<f64>, Vec<f64>) {
+        let op = (0..n)
+            .map(|k| 50.0 + 5.0 * (k as f64 * 0.1).sin())
+            .collect();
+        let pv = (0..n)
+            .map(|k| 20.0 + 2.0 * (k as f64 * 0.1 - 0.5).sin())
+            .collect();
+        (op, pv)
+    }
+
+    fn failed(f: &[Finding]) -> Vec<String> {
+        f.iter()
+            .filter(|f| !f.passed)
+            .map(|f| f.gate.clone())
+            .collect()
+    }
+
+    #[test]
+    fn a_clean_record_passes_every_gate() {
+        let (op, pv) = loop_record(1000);
+        let sp = vec![20.0; 1000];
+        let t: Vec<f64> = (0..1000).map(|k| k as f64).collect();
+        let auto = vec![true; 1000];
+        let r = Record {
+            op: &op,
+            pv: &pv,
+            sp: Some(&sp),
+            time: Some(&t),
+            auto: Some(&auto),
+        };
+        let f = check(&r, &Limits::default());
+        assert_eq!(f.len(), 6);
+        assert!(failed(&f).is_empty(), "{f:?}");
+    }
+
+    #[test]
+    fn each_defect_fails_its_gate() {
+        let (mut op, mut pv) = loop_record(1000);
+        for v in &mut op[..200] {
+            *v = 100.0;
+        }
+        for k in (0..1000).step_by(2) {
+            pv[k + 1] = pv[k];
+        }
+        for v in &mut pv[..700] {
+            *v = (*v * 2.0).round() / 2.0;
+        }
+        let mut sp = vec![20.0; 1000];
+        sp[500..].fill(21.0);
+        let mut t: Vec<f64> = (0..1000).map(|k| k as f64).collect();
+        for v in &mut t[600..] {
+            *v += 30.0;
+        }
+        let mut auto = vec![true; 1000];
+        auto[100] = false;
+        let r = Record {
+            op: &op,
+            pv: &pv,
+            sp: Some(&sp),
+            time: Some(&t),
+            auto: Some(&auto),
+        };
+        let f = failed(&check(&r, &Limits::default()));
+        for gate in [
+            "op_saturated",
+            "pv_frozen",
+            "manual_mode",
+            "setpoint_changes",
+            "time_gaps",
+        ] {
+            assert!(f.contains(&gate.to_string()), "{gate} not failed: {f:?}");
+        }
+    }
+
+    #[test]
+    fn a_quantised_pv_is_caught() {
+        let (op, pv) = loop_record(1000);
+        let coarse: Vec<f64> = pv.iter().map(|v| v.round()).collect();
+        let r = Record {
+            op: &op,
+            pv: &coarse,
+            sp: None,
+            time: None,
+            auto: None,
+        };
+        assert!(failed(&check(&r, &Limits::default())).contains(&"pv_quantised".to_string()));
+    }
+}
