@@ -237,6 +237,164 @@ pub fn horch(op: &[f64], pv: &[f64], ts: f64, max_lag: usize) -> CrossCorrelatio
     }
 }
 
+/// Half cycles of a signal: the stretches between its crossings of the mean, found with a
+/// hysteresis band (a crossing counts once the signal is `hysteresis` past the mean on the other
+/// side) so measurement noise does not chop them. Each as `[start, end)`.
+pub fn half_cycles(x: &[f64], hysteresis: f64) -> Vec<(usize, usize)> {
+    let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
+    let mut out = Vec::new();
+    let mut side = 0.0f64;
+    let mut start: Option<usize> = None;
+    for (k, &v) in x.iter().enumerate() {
+        let d = v - mean;
+        let now = if d > hysteresis {
+            1.0
+        } else if d < -hysteresis {
+            -1.0
+        } else {
+            continue;
+        };
+        if now != side {
+            // walk back to where the signal actually crossed the mean
+            let mut c = k;
+            while c > 0 && (x[c - 1] - mean) * now > 0.0 {
+                c -= 1;
+            }
+            if let Some(s) = start {
+                out.push((s, c));
+            }
+            if side != 0.0 || start.is_none() {
+                start = Some(c);
+            }
+            side = now;
+        }
+    }
+    // the first stretch starts wherever the record does, not at a crossing: drop it
+    if !out.is_empty() {
+        out.remove(0);
+    }
+    out
+}
+
+/// A shape index with its vote.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShapeIndex {
+    pub value: f64,
+    pub half_cycles: usize,
+    pub stiction_above: f64,
+    pub no_stiction_below: f64,
+    /// "stiction", "no_stiction" or "undetermined" (also when there are too few half cycles).
+    pub vote: String,
+}
+
+fn vote(value: f64, half_cycles: usize, hi: f64, lo: f64) -> String {
+    if half_cycles < 4 || !value.is_finite() {
+        "undetermined"
+    } else if value >= hi {
+        "stiction"
+    } else if value <= lo {
+        "no_stiction"
+    } else {
+        "undetermined"
+    }
+    .into()
+}
+
+/// Residual sum of squares of the least-squares fit `x ≈ a φ`.
+fn fit_rss(x: &[f64], phi: impl Fn(usize) -> f64) -> f64 {
+    let (mut xp, mut pp, mut xx) = (0.0, 0.0, 0.0);
+    for (k, &v) in x.iter().enumerate() {
+        let p = phi(k);
+        xp += v * p;
+        pp += p * p;
+        xx += v * v;
+    }
+    if pp > 0.0 {
+        (xx - xp * xp / pp).max(0.0)
+    } else {
+        xx
+    }
+}
+
+fn sine_rss(x: &[f64]) -> f64 {
+    let m = x.len() as f64;
+    fit_rss(x, |k| (std::f64::consts::PI * (k as f64 + 0.5) / m).sin())
+}
+
+/// The best triangle over every peak position.
+fn triangle_rss(x: &[f64]) -> f64 {
+    let m = x.len();
+    (1..m)
+        .map(|p| {
+            fit_rss(x, |k| {
+                let t = k as f64 + 0.5;
+                if k < p {
+                    t / p as f64
+                } else {
+                    (m as f64 - t) / (m - p) as f64
+                }
+            })
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn half_cycle_fits(x: &[f64], hysteresis: f64, rss: [fn(&[f64]) -> f64; 2]) -> (f64, f64, usize) {
+    let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
+    let cycles = half_cycles(x, hysteresis);
+    let (mut a, mut b) = (0.0, 0.0);
+    let mut used = 0;
+    for &(s, e) in &cycles {
+        if e - s < 4 {
+            continue;
+        }
+        let seg: Vec<f64> = x[s..e].iter().map(|v| v - mean).collect();
+        a += rss[0](&seg);
+        b += rss[1](&seg);
+        used += 1;
+    }
+    (a, b, used)
+}
+
+/// He et al. (2007) curve-fitting index on a signal (OP for self-regulating loops, PV for
+/// integrating ones): a sine and a triangle fitted to each half cycle;
+/// SI = MSE_sine / (MSE_sine + MSE_triangle), stiction at 0.6 and above, none at 0.4 and below.
+pub fn curve_fitting_index(x: &[f64], hysteresis: f64) -> ShapeIndex {
+    let (sine, tri, used) = half_cycle_fits(x, hysteresis, [sine_rss, triangle_rss]);
+    let value = if sine + tri > 0.0 {
+        sine / (sine + tri)
+    } else {
+        f64::NAN
+    };
+    ShapeIndex {
+        value,
+        half_cycles: used,
+        stiction_above: 0.6,
+        no_stiction_below: 0.4,
+        vote: vote(value, used, 0.6, 0.4),
+    }
+}
+
+/// Hägglund (2011) shape index on the control error: a sine and a square wave fitted to each half
+/// period; (V_sine - V_square) / (V_sine + V_square) > 0 means square-like, i.e. stiction.
+pub fn shape_index(error: &[f64], hysteresis: f64) -> ShapeIndex {
+    fn square_rss(x: &[f64]) -> f64 {
+        fit_rss(x, |_| 1.0)
+    }
+    let (sine, square, used) = half_cycle_fits(error, hysteresis, [sine_rss, square_rss]);
+    let value = if sine + square > 0.0 {
+        (sine - square) / (sine + square)
+    } else {
+        f64::NAN
+    };
+    ShapeIndex {
+        value,
+        half_cycles: used,
+        stiction_above: 0.0,
+        no_stiction_below: 0.0,
+        vote: vote(value, used, f64::MIN_POSITIVE, 0.0),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -309,6 +467,58 @@ mod tests {
         let even = horch(&op, &anti, 1.0, 60);
         assert_eq!(even.vote, "no_stiction", "{even:?}");
         assert!((even.tau_right.unwrap() - 12.5).abs() < 0.5, "{even:?}");
+    }
+
+    fn wave(n: usize, period: f64, shape: fn(f64) -> f64, noise: f64) -> Vec<f64> {
+        let mut rng = seeded(8);
+        (0..n)
+            .map(|k| shape((k as f64 / period).fract()) + noise * gaussian(&mut rng))
+            .collect()
+    }
+    fn sin01(p: f64) -> f64 {
+        (std::f64::consts::TAU * p).sin()
+    }
+    fn tri01(p: f64) -> f64 {
+        if p < 0.25 {
+            4.0 * p
+        } else if p < 0.75 {
+            2.0 - 4.0 * p
+        } else {
+            4.0 * p - 4.0
+        }
+    }
+    fn sq01(p: f64) -> f64 {
+        if p < 0.5 {
+            1.0
+        } else {
+            -1.0
+        }
+    }
+
+    #[test]
+    fn half_cycles_of_a_noisy_sine() {
+        let x = wave(1000, 50.0, sin01, 0.1);
+        let h = half_cycles(&x, 0.3);
+        assert!((36..=40).contains(&h.len()), "{}", h.len());
+        for &(s, e) in &h {
+            assert!((20..=30).contains(&(e - s)), "{s}..{e}");
+        }
+    }
+
+    #[test]
+    fn curve_fitting_tells_triangles_from_sines() {
+        let tri = curve_fitting_index(&wave(2000, 60.0, tri01, 0.05), 0.3);
+        assert_eq!(tri.vote, "stiction", "{tri:?}");
+        let sine = curve_fitting_index(&wave(2000, 60.0, sin01, 0.05), 0.3);
+        assert_eq!(sine.vote, "no_stiction", "{sine:?}");
+    }
+
+    #[test]
+    fn shape_index_tells_squares_from_sines() {
+        let square = shape_index(&wave(2000, 60.0, sq01, 0.05), 0.3);
+        assert_eq!(square.vote, "stiction", "{square:?}");
+        let sine = shape_index(&wave(2000, 60.0, sin01, 0.05), 0.3);
+        assert_eq!(sine.vote, "no_stiction", "{sine:?}");
     }
 
     #[test]
