@@ -129,9 +129,7 @@ impl Table {
         }
         Ok(out)
     }
-}
 
-impl Table {
     /// Parse a time column: seconds as numbers, or text timestamps (ISO 8601, `YYYY-MM-DD HH:MM:SS`),
     /// returned as seconds (text timestamps: since 1970).
     pub fn times(&self, col: usize) -> Result<Vec<f64>> {

@@ -202,39 +202,6 @@ impl Cells {
     }
 }
 
-/// The partition of `[lo, hi)` into cells on which the Stenman valve trajectory driven by `op` is
-/// identical, sorted by d. With no measured valve position there is no cost to prune by: every
-/// cell is a distinct candidate (used for closed-loop identification).
-pub fn stenman_cells(op: &[f64], lo: f64, hi: f64) -> Vec<(f64, f64)> {
-    assert!(!op.is_empty() && lo < hi);
-    let mut cells = Cells::default();
-    cells.push(lo, hi, op[0], 0.0);
-    let mut born = Cells::default();
-    for &u in &op[1..] {
-        for i in 0..cells.len() {
-            let (clo, chi, x) = (cells.lo[i], cells.hi[i], cells.x[i]);
-            let delta = (u - x).abs();
-            if delta <= clo {
-                continue;
-            }
-            if delta < chi {
-                born.push(delta, chi, x, 0.0);
-                cells.hi[i] = delta;
-            }
-            cells.x[i] = u;
-        }
-        cells.append(&mut born);
-    }
-    let mut out: Vec<(f64, f64)> = cells
-        .lo
-        .iter()
-        .copied()
-        .zip(cells.hi.iter().copied())
-        .collect();
-    out.sort_by(|a, b| a.0.total_cmp(&b.0));
-    out
-}
-
 /// The cell of the Stenman partition that contains `d`: the range of d values whose valve
 /// trajectory driven by `op` is the same as d's, clipped to `[lo, hi)`. One pass over the data:
 /// the trajectory stays the same while every sticking step keeps `|u - x| <= d` and every slip
