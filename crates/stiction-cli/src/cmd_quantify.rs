@@ -71,7 +71,7 @@ pub fn run(a: Args) -> Result<()> {
     let time = time_col.map(|c| table.times(c)).transpose()?;
     let ts = match (a.ts, &time) {
         (Some(ts), _) => ts,
-        (None, Some(t)) => sampling_time(t).with_context(|| {
+        (None, Some(t)) => data::sampling_time(t).with_context(|| {
             format!(
                 "{}: the time column '{}' does not increase; give the sampling time with --ts SECONDS",
                 a.file.display(),
@@ -140,17 +140,6 @@ pub fn run(a: Args) -> Result<()> {
     }
     print_human(&a.file.display().to_string(), &q, a.plot.as_deref());
     Ok(())
-}
-
-/// The median step of a time column, if time increases.
-fn sampling_time(t: &[f64]) -> Option<f64> {
-    let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    if steps.is_empty() {
-        return None;
-    }
-    steps.sort_by(f64::total_cmp);
-    let ts = steps[steps.len() / 2];
-    (ts > 0.0 && ts.is_finite()).then_some(ts)
 }
 
 fn print_human(file: &str, q: &Quantification, plot_dir: Option<&Path>) {

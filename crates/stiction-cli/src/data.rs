@@ -115,7 +115,8 @@ impl Table {
                 }
                 bail!("{file}: line {line}, column '{name}' is empty; fill in the value or remove the row");
             }
-            let v: f64 = cell.parse().map_err(|_| {
+            // a decimal comma (European historian exports, semicolon separated) reads as a point
+            let v: f64 = parse_number(cell).ok_or_else(|| {
                 anyhow::anyhow!(
                     "{file}: line {line}, column '{name}': '{cell}' is not a number; use plain decimal numbers such as 12.5"
                 )
@@ -126,6 +127,28 @@ impl Table {
                 );
             }
             out.push(v);
+        }
+        Ok(out)
+    }
+
+    /// Parse a mode column as `true` where the loop is in automatic: auto / manual (also AUT, MAN,
+    /// cascade, CAS), 1 / 0, true / false, on / off.
+    pub fn modes(&self, col: usize) -> Result<Vec<bool>> {
+        let name = &self.headers[col];
+        let file = self.path.display();
+        let mut out = Vec::with_capacity(self.rows.len());
+        for (i, row) in self.rows.iter().enumerate() {
+            let cell = row[col].to_ascii_lowercase();
+            let auto = match cell.as_str() {
+                "auto" | "automatic" | "aut" | "a" | "1" | "true" | "on" | "cascade" | "cas" => true,
+                "manual" | "man" | "m" | "0" | "false" | "off" => false,
+                _ => bail!(
+                    "{file}: line {}, column '{name}': '{}' is not a controller mode; use auto or manual (also 1 or 0)",
+                    self.lines[i],
+                    row[col]
+                ),
+            };
+            out.push(auto);
         }
         Ok(out)
     }
@@ -154,6 +177,26 @@ impl Table {
         }
         Ok(out)
     }
+}
+
+/// A number with a decimal point, or with a decimal comma and no point (`12,5`).
+fn parse_number(cell: &str) -> Option<f64> {
+    cell.parse().ok().or_else(|| {
+        (cell.matches(',').count() == 1 && !cell.contains('.'))
+            .then(|| cell.replace(',', ".").parse().ok())
+            .flatten()
+    })
+}
+
+/// The median step of a time column, if time increases.
+pub fn sampling_time(t: &[f64]) -> Option<f64> {
+    let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    if steps.is_empty() {
+        return None;
+    }
+    steps.sort_by(f64::total_cmp);
+    let ts = steps[steps.len() / 2];
+    (ts > 0.0 && ts.is_finite()).then_some(ts)
 }
 
 /// The delimiter the header line uses most: comma, semicolon or tab.

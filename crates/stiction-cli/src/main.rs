@@ -2,6 +2,7 @@
 //! flags are parsed here, turned into validated core requests, and results printed by a human or a
 //! JSON printer.
 
+mod cmd_diagnose;
 mod cmd_estimate;
 mod cmd_quantify;
 mod cmd_reproduce;
@@ -36,6 +37,8 @@ enum Command {
     Estimate(cmd_estimate::Args),
     /// Quantify stiction from OP and PV alone (closed-loop Hammerstein identification).
     Quantify(cmd_quantify::Args),
+    /// Diagnose a loop from routine data: quality gates, oscillation, stiction indices and a verdict.
+    Diagnose(cmd_diagnose::Args),
     /// Reproduce published results (`stiction reproduce paper`).
     Reproduce(cmd_reproduce::Args),
 }
@@ -46,6 +49,7 @@ fn main() -> ExitCode {
         Command::Simulate(a) => cmd_simulate::run(a),
         Command::Estimate(a) => cmd_estimate::run(a),
         Command::Quantify(a) => cmd_quantify::run(a),
+        Command::Diagnose(a) => cmd_diagnose::run(a),
         Command::Reproduce(a) => cmd_reproduce::run(a),
     };
     match result {

@@ -26,6 +26,9 @@ pub struct Regularity {
 /// Default threshold on Thornhill's r.
 pub const REGULARITY_THRESHOLD: f64 = 1.0;
 
+/// Zero crossings of the autocorrelation used for the periods (about five periods).
+pub const MAX_CROSSINGS: usize = 11;
+
 /// Autocorrelation of a mean-free copy of `x` for lags `0..=max_lag` (biased estimator, so r(0) = 1).
 pub fn autocorrelation(x: &[f64], max_lag: usize) -> Vec<f64> {
     let n = x.len();
@@ -59,6 +62,9 @@ pub fn regularity(error: &[f64], ts: f64) -> Regularity {
             crossings.push((k - 1) as f64 + frac);
         }
     }
+    // Thornhill et al. use the first crossings only: deep into the lags the autocorrelation of
+    // a noisy record wanders around zero and adds crossings that are not the oscillation's
+    crossings.truncate(MAX_CROSSINGS);
     // each pair of crossings two apart spans one period
     let periods: Vec<f64> = crossings.windows(3).map(|w| (w[2] - w[0]) * ts).collect();
     let (period, r) = if periods.is_empty() {

@@ -4,6 +4,7 @@
 //! files, prints or plots. The command-line tool and every other front end share these results.
 
 pub mod detect;
+pub mod diagnose;
 pub mod estimate;
 pub mod identify;
 pub mod models;

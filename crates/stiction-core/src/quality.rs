@@ -75,16 +75,26 @@ pub fn check(r: &Record, limits: &Limits) -> Vec<Finding> {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
                 (a.min(v), b.max(v))
             });
-    let at_limit =
-        r.op.iter()
-            .filter(|&&v| v <= 0.0 || v >= 100.0 || (hi > lo && (v == lo || v == hi)))
-            .count();
-    // a few samples at the record's own extremes are normal; long stretches there are not
-    let share = if hi > lo {
-        at_limit.saturating_sub(2) as f64 / n
-    } else {
-        1.0
-    };
+    // 0 % and 100 % are limits only for an OP in percent; normalised or engineering-unit OPs
+    // (negative values, values above 100) are held to their own extremes alone
+    let percent = lo >= 0.0 && hi <= 100.0;
+    let mut at_limit = 0usize;
+    let mut k = 0;
+    while k < r.op.len() {
+        let v = r.op[k];
+        let mut run = 1;
+        while k + run < r.op.len() && r.op[k + run] == v {
+            run += 1;
+        }
+        let at_percent_limit = percent && (v <= 0.0 || v >= 100.0);
+        // a value held at the record's own extreme for a while: pinned at a limit we cannot see
+        let pinned = hi > lo && (v == lo || v == hi) && run >= 3;
+        if at_percent_limit || pinned {
+            at_limit += run;
+        }
+        k += run;
+    }
+    let share = if hi > lo { at_limit as f64 / n } else { 1.0 };
     out.push(finding(
         "op_saturated",
         share <= limits.saturated_share,
