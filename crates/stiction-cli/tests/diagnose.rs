@@ -1,0 +1,246 @@
+//! `stiction diagnose` as a user types it: the binary is spawned, its output read.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn stiction(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_stiction"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = stiction(args);
+    assert!(
+        out.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn fails(args: &[&str], needles: &[&str]) {
+    let out = stiction(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} should fail");
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    assert_eq!(
+        err.trim().lines().count(),
+        1,
+        "{args:?}: not one line: {err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: '{n}' missing from: {err}");
+    }
+}
+
+fn json(text: &str) -> serde_json::Value {
+    serde_json::from_str(text).expect("valid JSON")
+}
+
+/// A closed loop (default process K = 3, tau = 10 s, delay = 10 s, PI 0.2 / 10 s).
+fn simulate(dir: &Path, name: &str, d: &str, extra: &[&str]) -> String {
+    let p = dir.join(name);
+    let f = p.to_str().unwrap().to_string();
+    let mut args = vec![
+        "simulate", "--loop", "closed", "--model", "stenman", "--param",
+    ];
+    let param = format!("d={d}");
+    args.push(&param);
+    args.extend_from_slice(&[
+        "--samples",
+        "1500",
+        "--noise",
+        "0.05",
+        "--seed",
+        "3",
+        "-o",
+        &f,
+    ]);
+    args.extend_from_slice(extra);
+    ok(&args);
+    f
+}
+
+fn rows(path: &str) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+#[test]
+fn a_sticky_loop_is_stiction_with_the_band_sized() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "sticky.csv", "2", &[]);
+    let v = json(&ok(&["diagnose", &f, "--sp", "sp", "--json"]));
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    assert!(v["confidence"].as_f64().unwrap() > 0.5);
+    let names: Vec<&str> = v["indices"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i["name"].as_str().unwrap())
+        .collect();
+    assert!(names.contains(&"cross_correlation") && names.contains(&"curve_fitting"));
+    for i in v["indices"].as_array().unwrap() {
+        assert!(i["threshold"].as_str().is_some() && i["vote"].as_str().is_some());
+    }
+    let d = v["apparent_stiction"]["closed_loop"].as_f64().unwrap();
+    assert!(d > 0.5 && d < 4.0, "closed-loop band {d}");
+    assert!(v["oscillation"]["period"].as_f64().unwrap() > 10.0);
+    // the human printer says the same
+    let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
+    assert!(text.contains("STICTION"), "{text}");
+    assert!(text.contains("cross_correlation"), "{text}");
+}
+
+#[test]
+fn a_healthy_loop_with_noise_only_is_no_stiction() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "healthy.csv", "0", &[]);
+    let v = json(&ok(&["diagnose", &f, "--sp", "sp", "--json"]));
+    assert_eq!(v["verdict"], "no_stiction", "{v:#}");
+    assert!(v.get("quantification").is_none());
+}
+
+#[test]
+fn windows_locate_the_verdict_in_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "sticky.csv", "2", &[]);
+    let v = json(&ok(&[
+        "diagnose",
+        &f,
+        "--window",
+        "500",
+        "--no-quantify",
+        "--json",
+    ]));
+    let w = v["windows"].as_array().unwrap();
+    assert_eq!(w.len(), 3);
+    assert_eq!(w[0]["start"], 0);
+    assert_eq!(w[2]["end"], 1500);
+    for x in w {
+        assert!(x["verdict"].as_str().is_some());
+    }
+}
+
+/// The sticky loop exported the way a historian does: semicolons, decimal commas, text
+/// timestamps every 2 s, a mode column.
+fn historian(dir: &Path, manual_until: usize, gap_at: Option<usize>) -> String {
+    let f = simulate(dir, "src.csv", "2", &[]);
+    let r = rows(&f);
+    let mut out = String::from("Timestamp;FIC101.OP;FIC101.PV;FIC101.SP;Mode\n");
+    for (k, c) in r.iter().skip(1).enumerate() {
+        let mut secs = 2 * k;
+        if gap_at.is_some_and(|g| k >= g) {
+            secs += 600;
+        }
+        let mode = if k < manual_until { "MAN" } else { "AUTO" };
+        out.push_str(&format!(
+            "2024-03-01 {:02}:{:02}:{:02};{};{};{};{mode}\n",
+            10 + secs / 3600,
+            (secs / 60) % 60,
+            secs % 60,
+            c[2].replace('.', ","),
+            c[4].replace('.', ","),
+            c[1].replace('.', ","),
+        ));
+    }
+    let p = dir.join("historian.csv");
+    std::fs::write(&p, out).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+#[test]
+fn historian_exports_with_timestamps_decimal_commas_and_a_mode_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let h = historian(dir.path(), 300, None);
+    let cols = [
+        "--op",
+        "FIC101.OP",
+        "--pv",
+        "FIC101.PV",
+        "--sp",
+        "FIC101.SP",
+        "--mode",
+        "Mode",
+    ];
+    let mut args = vec!["diagnose", &h];
+    args.extend_from_slice(&cols);
+    args.extend_from_slice(&["--json", "--no-quantify"]);
+    let v = json(&ok(&args));
+    assert_eq!(v["ts"], 2.0);
+    // the manual stretch is left out
+    assert_eq!(v["analysed"][0], 300);
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+
+    // always in manual: no verdict, and never a false "no stiction"
+    let m = historian(dir.path(), 2000, None);
+    let mut args = vec!["diagnose", &m];
+    args.extend_from_slice(&cols);
+    args.push("--json");
+    let v = json(&ok(&args));
+    assert_eq!(v["verdict"], "insufficient_data");
+    assert!(v["reason"].as_str().unwrap().contains("manual"), "{v:#}");
+
+    // a gap in the time axis
+    let g = historian(dir.path(), 0, Some(700));
+    let mut args = vec!["diagnose", &g];
+    args.extend_from_slice(&cols);
+    args.push("--json");
+    let v = json(&ok(&args));
+    assert_eq!(v["verdict"], "insufficient_data");
+    assert!(v["reason"].as_str().unwrap().contains("gap"), "{v:#}");
+}
+
+#[test]
+fn saturated_and_constant_loops_are_insufficient_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("t,op,pv\n");
+    for k in 0..1000 {
+        let pv = 50.0 + (k as f64 * 0.1).sin();
+        text.push_str(&format!("{k},100,{pv}\n"));
+    }
+    let p = dir.path().join("sat.csv");
+    std::fs::write(&p, text).unwrap();
+    let v = json(&ok(&["diagnose", p.to_str().unwrap(), "--json"]));
+    assert_eq!(v["verdict"], "insufficient_data");
+    let text = ok(&["diagnose", p.to_str().unwrap()]);
+    assert!(text.contains("insufficient data"), "{text}");
+}
+
+#[test]
+fn bad_input_is_one_clear_sentence() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "loop.csv", "2", &[]);
+    fails(
+        &["diagnose", &f, "--sp", "setpoint"],
+        &["'setpoint'", "--sp"],
+    );
+    fails(&["diagnose", &f, "--window", "10"], &["--window 10"]);
+    fails(&["diagnose", &f, "--ts", "0"], &["--ts 0"]);
+    let mut text = String::from("t,op,pv,mode\n");
+    for k in 0..300 {
+        text.push_str(&format!(
+            "{k},{},{},{}\n",
+            50.0 + (k % 7) as f64,
+            k,
+            if k == 5 { "maybe" } else { "1" }
+        ));
+    }
+    let p = dir.path().join("mode.csv");
+    std::fs::write(&p, text).unwrap();
+    fails(
+        &["diagnose", p.to_str().unwrap(), "--mode", "mode"],
+        &["mode.csv", "line 7", "'mode'", "'maybe'", "auto or manual"],
+    );
+    let p = dir.path().join("empty.csv");
+    std::fs::write(&p, "t,op,pv\n").unwrap();
+    fails(
+        &["diagnose", p.to_str().unwrap()],
+        &["empty.csv", "no data rows"],
+    );
+}
