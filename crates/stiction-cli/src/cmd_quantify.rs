@@ -44,6 +44,10 @@ pub struct Args {
     /// exact: fit only the trajectories near the best points of a coarse scan (faster; exact there only)
     #[arg(long)]
     quick: bool,
+    /// exact: fit every trajectory of the whole record (slower), not only the best cells of a
+    /// search on the first samples (the default from 1,500 samples on)
+    #[arg(long)]
+    full: bool,
     /// aco, aco-r: ants per iteration
     #[arg(long)]
     ants: Option<usize>,
@@ -86,6 +90,7 @@ pub fn run(a: Args) -> Result<()> {
     req.seed = a.fit.seed;
     req.max_delay = a.max_delay;
     req.full_partition = !a.quick;
+    req.staged = !a.full;
     req.integrating = if a.integrating {
         Some(true)
     } else if a.self_regulating {
@@ -162,6 +167,7 @@ fn print_human(file: &str, q: &Quantification, plot_dir: Option<&Path>) {
             let what = match q.interval_kind.as_str() {
                 "exact" => "every value in",
                 "exact_local" => "every value in (exact near the best scan points)",
+                "exact_staged" => "every value in (exact over the best cells of the first samples)",
                 "grid" => "grid points at the minimum span",
                 _ => "fits equally well with the others fixed over",
             };

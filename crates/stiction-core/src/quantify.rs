@@ -42,6 +42,11 @@ pub struct QuantifyRequest {
     pub integrating: Option<bool>,
     /// Stenman exact: fit every cell of the whole d-range, not only those around the best scan points.
     pub full_partition: bool,
+    /// Stenman exact on long records: search the whole d-range on the first samples, then only
+    /// the best cells of that search on the whole record (every whole-record cell lies inside one
+    /// cell of the first samples', so this is exact over the cells kept). `false`: every cell of
+    /// the whole record.
+    pub staged: bool,
 }
 
 impl QuantifyRequest {
@@ -62,6 +67,7 @@ impl QuantifyRequest {
             max_delay: 30,
             integrating: None,
             full_partition: true,
+            staged: true,
         }
     }
 }
@@ -271,6 +277,46 @@ pub fn quantify(
 ) -> Result<Quantification, EstimateError> {
     let started = Instant::now();
     let n = op.len();
+    if req.model == ModelKind::Stenman
+        && req.method == Method::Exact
+        && req.staged
+        && n >= STAGE_FROM
+        && pv.len() == n
+    {
+        // stage 1: the whole d-range on the first samples (same valve start, so every
+        // whole-record cell lies inside one of its cells)
+        let m = STAGE_SAMPLES.max(n / 10);
+        let mut first = req.clone();
+        first.staged = false;
+        first.full_partition = true;
+        if let Ok((q, hint)) = quantify_inner(&op[..m], &pv[..m], &first, None) {
+            if q.status == "ok" && !hint.ranges.is_empty() {
+                let (mut full, _) = quantify_inner(op, pv, req, Some(&hint))?;
+                full.evaluations += q.evaluations;
+                full.seconds = started.elapsed().as_secs_f64();
+                return Ok(full);
+            }
+        }
+    }
+    quantify_inner(op, pv, req, None).map(|r| r.0)
+}
+
+/// What a staged search carries from the first samples to the whole record.
+struct Hint {
+    /// The structures tried, best first.
+    structures: Vec<Structure>,
+    /// The cells of least cost, merged, in increasing d.
+    ranges: Vec<(f64, f64)>,
+}
+
+fn quantify_inner(
+    op: &[f64],
+    pv: &[f64],
+    req: &QuantifyRequest,
+    hint: Option<&Hint>,
+) -> Result<(Quantification, Hint), EstimateError> {
+    let started = Instant::now();
+    let n = op.len();
     estimate::check_pair(("op", op), ("pv", pv))?;
     if !(req.ts > 0.0 && req.ts.is_finite()) {
         return Err(EstimateError::Settings(format!(
@@ -290,8 +336,15 @@ pub fn quantify(
         search.self_regulating = !integrating;
     }
     let needed = search.t0() + 20 * (search.na.len() + search.nb_max + 1);
-    let insufficient =
-        |why: String| Ok(Quantification::insufficient(req, n, op_range.max(0.0), why));
+    let insufficient = |why: String| {
+        Ok((
+            Quantification::insufficient(req, n, op_range.max(0.0), why),
+            Hint {
+                structures: Vec::new(),
+                ranges: Vec::new(),
+            },
+        ))
+    };
     if n < needed {
         return insufficient(format!(
             "only {n} samples; the linear model search (delays up to {} samples) needs at least {needed}",
@@ -322,7 +375,11 @@ pub fn quantify(
     let data = Data::new(pv, search.t0());
     let mut evaluations = 0u64;
     // pilot: the process family and a first structure, chosen at a spread of stiction parameters
-    let pilots = pilot_points(req.model, &bounds);
+    let pilots = if hint.is_some() {
+        Vec::new() // the first stage chose the structures
+    } else {
+        pilot_points(req.model, &bounds)
+    };
     let choices: Vec<identify::Selection> = pilots
         .par_iter()
         .filter_map(|theta| {
@@ -355,6 +412,9 @@ pub fn quantify(
             });
             stenman_d = Some(*d);
         }
+    }
+    if let Some(h) = hint {
+        queue.extend(h.structures.iter().take(STARTING_STRUCTURES));
     }
     for c in &ranked {
         if !queue.contains(&c.structure) && queue.len() < STARTING_STRUCTURES {
@@ -393,7 +453,12 @@ pub fn quantify(
             .map(|&s| Hammerstein::new(req.model, op, &data, s))
             .collect();
         let outcomes = match req.method {
-            Method::Exact => exact_stenman(&problems, bounds[0], req.full_partition),
+            Method::Exact => exact_stenman(
+                &problems,
+                bounds[0],
+                req.full_partition,
+                hint.map(|h| h.ranges.as_slice()),
+            ),
             Method::Grid => vec![grid_search(&problems[0], &bounds, &req.grid)],
             Method::Aco | Method::AcoR => {
                 let problem = &problems[0];
@@ -422,6 +487,7 @@ pub fn quantify(
                     interval_kind: "axis",
                     evaluations: ev.evaluations() + extra + polish_evals,
                     cells: None,
+                    top_cells: Vec::new(),
                 }]
             }
         };
@@ -443,10 +509,26 @@ pub fn quantify(
             }
         }
     }
-    let (structure, outcome, _) = tried
-        .into_iter()
-        .min_by(|a, b| a.2.total_cmp(&b.2))
-        .expect("at least one search ran");
+    tried.sort_by(|a, b| a.2.total_cmp(&b.2));
+    // for a staged search: the structures best first, and the best cells of the two best
+    let mut ranges: Vec<(f64, f64)> = tried
+        .iter()
+        .take(2)
+        .flat_map(|t| t.1.top_cells.iter().copied())
+        .collect();
+    ranges.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut merged: Vec<(f64, f64)> = Vec::new();
+    for r in ranges {
+        match merged.last_mut() {
+            Some(last) if last.1 >= r.0 => last.1 = last.1.max(r.1),
+            _ => merged.push(r),
+        }
+    }
+    let next = Hint {
+        structures: tried.iter().map(|t| t.0).collect(),
+        ranges: merged,
+    };
+    let (structure, outcome, _) = tried.into_iter().next().expect("at least one search ran");
 
     let problem = Hammerstein::new(req.model, op, &data, structure);
     let Some(fit) = problem.fit(&outcome.best) else {
@@ -490,35 +572,36 @@ pub fn quantify(
         ));
     }
     let s = fit.structure;
-    Ok(Quantification {
-        status: "ok".into(),
-        reason: None,
-        model: req.model,
-        method: req.method,
-        params: names
-            .iter()
-            .zip(&outcome.best)
-            .map(|(n, &v)| (n.to_string(), v))
-            .collect(),
-        interval: outcome.interval,
-        interval_kind: outcome.interval_kind.into(),
-        linear_model: Some(LinearModel {
-            family: if s.integrating {
-                "integrating"
-            } else {
-                "self_regulating"
-            }
-            .into(),
-            na: s.na,
-            nb: s.nb,
-            nk: s.nk,
-            a: fit.a.clone(),
-            b: fit.b.clone(),
-            c: fit.c,
-            gain: phys.gain,
-            time_constant: phys.time_constant,
-            dead_time: phys.dead_time,
-            criterion: format!(
+    Ok((
+        Quantification {
+            status: "ok".into(),
+            reason: None,
+            model: req.model,
+            method: req.method,
+            params: names
+                .iter()
+                .zip(&outcome.best)
+                .map(|(n, &v)| (n.to_string(), v))
+                .collect(),
+            interval: outcome.interval,
+            interval_kind: outcome.interval_kind.into(),
+            linear_model: Some(LinearModel {
+                family: if s.integrating {
+                    "integrating"
+                } else {
+                    "self_regulating"
+                }
+                .into(),
+                na: s.na,
+                nb: s.nb,
+                nk: s.nk,
+                a: fit.a.clone(),
+                b: fit.b.clone(),
+                c: fit.c,
+                gain: phys.gain,
+                time_constant: phys.time_constant,
+                dead_time: phys.dead_time,
+                criterion: format!(
                 "BIC of one-step prediction over na in {:?}, nb 1..={}, delay 1..={} samples, {}",
                 search.na,
                 search.nb_max,
@@ -529,27 +612,29 @@ pub fn quantify(
                     _ => "integrating",
                 }
             ),
-        }),
-        fit: Some(FitQuality {
-            output: if s.integrating { "delta_pv" } else { "pv" }.into(),
-            r2_simulation: fit.r2_simulation(),
-            r2_one_step: fit.r2_one_step(),
-            sse_simulation: fit.sse_simulation,
-        }),
-        apparent_stiction: Some(band),
-        apparent_stiction_pct_of_op_range: Some(100.0 * band / op_range),
-        op_range,
-        evaluations,
-        cells: outcome.cells,
-        seconds: started.elapsed().as_secs_f64(),
-        samples: n,
-        ts: req.ts,
-        seed,
-        warnings,
-        caveat: CAVEAT.into(),
-        mv,
-        pv_simulated,
-    })
+            }),
+            fit: Some(FitQuality {
+                output: if s.integrating { "delta_pv" } else { "pv" }.into(),
+                r2_simulation: fit.r2_simulation(),
+                r2_one_step: fit.r2_one_step(),
+                sse_simulation: fit.sse_simulation,
+            }),
+            apparent_stiction: Some(band),
+            apparent_stiction_pct_of_op_range: Some(100.0 * band / op_range),
+            op_range,
+            evaluations,
+            cells: outcome.cells,
+            seconds: started.elapsed().as_secs_f64(),
+            samples: n,
+            ts: req.ts,
+            seed,
+            warnings,
+            caveat: CAVEAT.into(),
+            mv,
+            pv_simulated,
+        },
+        next,
+    ))
 }
 
 /// Starting points for a two-parameter search from the Stenman band d.
@@ -627,6 +712,8 @@ struct Outcome {
     interval_kind: &'static str,
     evaluations: u64,
     cells: Option<usize>,
+    /// Stenman exact: the cells of least cost, best first (for a staged search).
+    top_cells: Vec<(f64, f64)>,
 }
 
 /// Parameter sets at which the linear structure is chosen before the main search.
@@ -657,6 +744,13 @@ fn pilot_points(kind: ModelKind, bounds: &[(f64, f64)]) -> Vec<Vec<f64>> {
     }
 }
 
+/// Cells of the first samples carried into the whole-record search of a staged search.
+const TOP_CELLS: usize = 24;
+/// A staged search starts on this many samples ...
+const STAGE_SAMPLES: usize = 600;
+/// ... when the record has at least this many.
+const STAGE_FROM: usize = 1500;
+
 /// A cell of the d-partition with its cost under each structure.
 type CellCosts = ((f64, f64), Vec<f64>);
 
@@ -665,16 +759,40 @@ type CellCosts = ((f64, f64), Vec<f64>);
 /// chunks walked in parallel, so the work spreads over threads and the result does not depend on
 /// their number. Without `full`, only the chunks around the best points of a coarse scan are walked
 /// (faster, exact only there). One outcome per structure, in order.
-fn exact_stenman(problems: &[Hammerstein], (lo, hi): (f64, f64), full: bool) -> Vec<Outcome> {
+fn exact_stenman(
+    problems: &[Hammerstein],
+    (lo, hi): (f64, f64),
+    full: bool,
+    only: Option<&[(f64, f64)]>,
+) -> Vec<Outcome> {
     const CHUNKS: usize = 64;
-    let first = (hi - lo) * 1e-4;
-    let mut edges: Vec<f64> = (0..CHUNKS)
-        .map(|i| lo + first * ((hi - lo) / first).powf(i as f64 / (CHUNKS - 1) as f64))
-        .collect();
-    edges[0] = lo;
-    edges.push(hi);
-    edges.dedup();
-    let mut chunks: Vec<(f64, f64)> = edges.windows(2).map(|w| (w[0], w[1])).collect();
+    let mut chunks: Vec<(f64, f64)> = match only {
+        // a staged search: the given ranges, each cut in a few chunks for the threads
+        Some(ranges) => ranges
+            .iter()
+            .flat_map(|&(a, b)| {
+                let k = 4;
+                (0..k).map(move |i| {
+                    (
+                        a + (b - a) * i as f64 / k as f64,
+                        a + (b - a) * (i + 1) as f64 / k as f64,
+                    )
+                })
+            })
+            .filter(|c| c.1 > c.0)
+            .collect(),
+        None => {
+            let first = (hi - lo) * 1e-4;
+            let mut edges: Vec<f64> = (0..CHUNKS)
+                .map(|i| lo + first * ((hi - lo) / first).powf(i as f64 / (CHUNKS - 1) as f64))
+                .collect();
+            edges[0] = lo;
+            edges.push(hi);
+            edges.dedup();
+            edges.windows(2).map(|w| (w[0], w[1])).collect()
+        }
+    };
+    let full = full || only.is_some();
     let scan: Vec<f64> = chunks.iter().map(|c| 0.5 * (c.0 + c.1)).collect();
     let scan_costs: Vec<Vec<f64>> = problems.iter().map(|p| p.costs_1d(&scan)).collect();
     if !full {
@@ -794,12 +912,19 @@ fn exact_stenman(problems: &[Hammerstein], (lo, hi): (f64, f64), full: bool) -> 
                 optimal.first().map_or(lo, |c| c.0),
                 optimal.last().map_or(hi, |c| c.1),
             ];
+            let mut ranked: Vec<&CellCosts> = cells.iter().collect();
+            ranked.sort_by(|x, y| x.1[s].total_cmp(&y.1[s]).then(x.0 .0.total_cmp(&y.0 .0)));
             Outcome {
                 best: vec![0.5 * (a + b)],
                 interval: BTreeMap::from([("d".to_string(), hull)]),
-                interval_kind: if full { "exact" } else { "exact_local" },
+                interval_kind: match (only.is_some(), full) {
+                    (true, _) => "exact_staged",
+                    (false, true) => "exact",
+                    (false, false) => "exact_local",
+                },
                 evaluations: (cells.len() + scan.len()) as u64,
                 cells: Some(cells.len()),
+                top_cells: ranked.iter().take(TOP_CELLS).map(|c| c.0).collect(),
             }
         })
         .collect()
@@ -847,6 +972,7 @@ fn grid_search(problem: &Hammerstein, bounds: &[(f64, f64)], settings: &GridSett
         interval_kind: "grid",
         evaluations: total as u64,
         cells: None,
+        top_cells: Vec::new(),
     }
 }
 
