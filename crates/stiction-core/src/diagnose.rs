@@ -154,7 +154,7 @@ impl Default for DiagnoseRequest {
             ts: 1.0,
             integrating: false,
             limits: Limits::default(),
-            min_periods: 5.0,
+            min_periods: 4.0,
             min_samples: 200,
             window: None,
             quantify: true,
@@ -180,8 +180,10 @@ pub struct LoopRecord<'a> {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Diagnosis {
     pub verdict: Verdict,
-    /// 0..1: the weighted share of the indices that support the verdict (for `insufficient_data`
-    /// and a loop without oscillation, how clear the deciding finding is).
+    /// 0..1: for `stiction` and `no_stiction` from the indices, the weighted share of the indices
+    /// that vote for the verdict; for `undetermined`, how far the weighted vote is from either
+    /// decision; for a loop without oscillation, 0.9 when the autocorrelation is clearly
+    /// irregular, else 0.6; for `insufficient_data`, 1 (the gate is certain).
     pub confidence: f64,
     /// For `insufficient_data`, `no_stiction` without oscillation: the reason in words.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -356,8 +358,11 @@ fn oscillation(error: &[f64], ts: f64) -> Oscillation {
     };
     let iae = detect::iae_count(error, ts, &settings);
     let periods = period.map(|p| error.len() as f64 * ts / p);
-    // a regular oscillation that stands out of the noise
-    let oscillating = regularity.oscillating && iae.exceedances >= 4 && amp > 3.0 * noise;
+    // an oscillation that stands out of the noise, found by either detector: Thornhill's
+    // regularity (a regular period) or Hägglund's IAE count (repeated large half periods, also
+    // when the period wanders)
+    let oscillating =
+        (regularity.oscillating && iae.exceedances >= 4 || iae.oscillating) && amp > 3.0 * noise;
     Oscillation {
         oscillating,
         period,
@@ -538,7 +543,8 @@ fn combine(indices: &[Index], margin: f64) -> (Verdict, f64) {
     let target = match verdict {
         Verdict::Stiction => Vote::Stiction,
         Verdict::NoStiction => Vote::NoStiction,
-        _ => Vote::Undetermined,
+        // undetermined: how far the vote is from either decision
+        _ => return (verdict, (1.0 - score.abs() / margin).clamp(0.0, 1.0)),
     };
     let support: f64 = indices
         .iter()
@@ -640,8 +646,8 @@ fn judge(r: &LoopRecord, whole: usize, (s, e): (usize, usize), req: &DiagnoseReq
     }
     if !osc.oscillating {
         let why = format!(
-            "no regular oscillation above the noise (regularity {:.2}, threshold {}; {} large half periods; amplitude {:.3} vs noise {:.3})",
-            osc.regularity.regularity, osc.regularity.threshold, osc.iae.exceedances, osc.amplitude, osc.noise_std
+            "no oscillation above the noise (regularity {:.2}, threshold {}; at most {} large half periods within {:.0} s, alarm at {}; amplitude {:.3} vs noise {:.3})",
+            osc.regularity.regularity, osc.regularity.threshold, osc.iae.most_in_window, osc.iae.window, osc.iae.n_lim, osc.amplitude, osc.noise_std
         );
         return Stretch {
             verdict: Verdict::NoStiction,
@@ -676,7 +682,7 @@ fn judge(r: &LoopRecord, whole: usize, (s, e): (usize, usize), req: &DiagnoseReq
     let indices = indices(op, pv, &error, &osc, req);
     let (verdict, confidence) = combine(&indices, req.verdict_margin);
     let mut evidence = vec![format!(
-        "regular oscillation: period {:.1} s, regularity {:.2}, amplitude {:.3} (noise {:.3})",
+        "oscillation: period {:.1} s, regularity {:.2}, amplitude {:.3} (noise {:.3})",
         osc.period.unwrap_or(0.0),
         osc.regularity.regularity,
         osc.amplitude,
