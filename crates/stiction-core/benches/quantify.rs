@@ -24,7 +24,13 @@ fn benches(c: &mut Criterion) {
         g.bench_function(format!("stenman_exact_{n}"), |b| {
             b.iter(|| quantify(black_box(&op), black_box(&pv), &req).unwrap())
         });
-        let mut quick = req.clone();
+        // the baseline: every cell of the whole record
+        let mut full = req.clone();
+        full.staged = false;
+        g.bench_function(format!("stenman_exact_full_{n}"), |b| {
+            b.iter(|| quantify(black_box(&op), black_box(&pv), &full).unwrap())
+        });
+        let mut quick = full.clone();
         quick.full_partition = false;
         g.bench_function(format!("stenman_exact_quick_{n}"), |b| {
             b.iter(|| quantify(black_box(&op), black_box(&pv), &quick).unwrap())

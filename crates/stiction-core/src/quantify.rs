@@ -285,7 +285,7 @@ pub fn quantify(
     {
         // stage 1: the whole d-range on the first samples (same valve start, so every
         // whole-record cell lies inside one of its cells)
-        let m = STAGE_SAMPLES.max(n / 10);
+        let m = STAGE_SAMPLES;
         let mut first = req.clone();
         first.staged = false;
         first.full_partition = true;
