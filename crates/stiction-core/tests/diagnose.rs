@@ -1,0 +1,156 @@
+//! The diagnosis: gates before verdicts, oscillation first, the indices' votes, windows.
+
+use stiction_core::diagnose::{diagnose, DiagnoseRequest, LoopRecord, Verdict, Vote};
+use stiction_core::models::{Model, Stenman};
+use stiction_core::sim::{ClosedLoop, LoopData, Process, Signal};
+
+fn run(d: f64, f: impl FnOnce(&mut ClosedLoop)) -> LoopData {
+    let mut cl = ClosedLoop::new(Model::Stenman(Stenman { d }));
+    cl.samples = 2000;
+    cl.noise = 0.05;
+    cl.seed = 11;
+    f(&mut cl);
+    cl.run().unwrap()
+}
+
+fn record(l: &LoopData) -> LoopRecord<'_> {
+    LoopRecord {
+        op: &l.op,
+        pv: &l.pv,
+        sp: Some(&l.sp),
+        time: Some(&l.t),
+        auto: None,
+    }
+}
+
+fn quick() -> DiagnoseRequest {
+    DiagnoseRequest {
+        quantify: false,
+        ..DiagnoseRequest::default()
+    }
+}
+
+#[test]
+fn sticky_healthy_and_disturbed_loops() {
+    let sticky = run(2.0, |_| {});
+    let d = diagnose(&record(&sticky), &DiagnoseRequest::default()).unwrap();
+    assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
+    let band = d.apparent_stiction.unwrap().closed_loop.unwrap();
+    assert!((band - 2.0).abs() < 0.5, "band {band}");
+    assert!(d.oscillation.unwrap().oscillating);
+    for i in &d.indices {
+        assert!(!i.threshold.is_empty() && !i.reference.is_empty());
+    }
+
+    let healthy = run(0.0, |_| {});
+    let d = diagnose(&record(&healthy), &quick()).unwrap();
+    assert_eq!(d.verdict, Verdict::NoStiction, "{:#?}", d.evidence);
+
+    // an external sinusoidal disturbance through a healthy valve: oscillates, not stiction
+    let disturbed = run(0.0, |cl| {
+        cl.process = Process::Foptd {
+            k: 1.0,
+            tau: 30.0,
+            delay: 5.0,
+        };
+        cl.pi.kc = 1.0;
+        cl.pi.ti = 30.0;
+        cl.disturbance = Some(Signal::Sine {
+            amplitude: 1.0,
+            period: 150.0,
+            offset: 0.0,
+        });
+    });
+    let d = diagnose(&record(&disturbed), &quick()).unwrap();
+    assert!(d.oscillation.as_ref().unwrap().oscillating);
+    assert_ne!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
+}
+
+#[test]
+fn a_failed_gate_is_never_a_verdict() {
+    let sticky = run(2.0, |_| {});
+    // every sample in manual
+    let auto = vec![false; sticky.op.len()];
+    let mut r = record(&sticky);
+    r.auto = Some(&auto);
+    let d = diagnose(&r, &quick()).unwrap();
+    assert_eq!(d.verdict, Verdict::InsufficientData);
+    assert!(d.indices.is_empty());
+    // OP stuck at 100 %
+    let op = vec![100.0; sticky.op.len()];
+    let mut r = record(&sticky);
+    r.op = &op;
+    let d = diagnose(&r, &quick()).unwrap();
+    assert_eq!(d.verdict, Verdict::InsufficientData);
+    // a frozen (compressed) PV
+    let pv: Vec<f64> = sticky.pv.iter().map(|v| (v * 0.2).round() / 0.2).collect();
+    let mut r = record(&sticky);
+    r.pv = &pv;
+    let d = diagnose(&r, &quick()).unwrap();
+    assert_eq!(d.verdict, Verdict::InsufficientData, "{:?}", d.reason);
+    // a gap in time
+    let mut t = sticky.t.clone();
+    for v in &mut t[1000..] {
+        *v += 500.0;
+    }
+    let mut r = record(&sticky);
+    r.time = Some(&t);
+    let d = diagnose(&r, &quick()).unwrap();
+    assert_eq!(d.verdict, Verdict::InsufficientData);
+    assert!(d.reason.unwrap().contains("gaps"));
+}
+
+#[test]
+fn manual_stretches_and_setpoint_changes_are_left_out() {
+    let sticky = run(2.0, |_| {});
+    let n = sticky.op.len();
+    let auto: Vec<bool> = (0..n).map(|k| k >= 400).collect();
+    let mut r = record(&sticky);
+    r.auto = Some(&auto);
+    let d = diagnose(&r, &quick()).unwrap();
+    assert_eq!(d.analysed, [400, n]);
+    assert_eq!(d.verdict, Verdict::Stiction);
+    // the default setpoint steps at 10 s: the stretch after it is analysed
+    let d = diagnose(&record(&sticky), &quick()).unwrap();
+    assert_eq!(d.analysed, [10, n]);
+}
+
+#[test]
+fn too_short_for_its_oscillation_is_insufficient_not_healthy() {
+    let sticky = run(2.0, |_| {});
+    let r = LoopRecord {
+        op: &sticky.op[500..700],
+        pv: &sticky.pv[500..700],
+        sp: None,
+        time: None,
+        auto: None,
+    };
+    let d = diagnose(&r, &quick()).unwrap();
+    assert_eq!(d.verdict, Verdict::InsufficientData, "{:?}", d.reason);
+}
+
+#[test]
+fn windows_cover_the_record_and_bad_requests_are_errors() {
+    let sticky = run(2.0, |cl| cl.samples = 3000);
+    let req = DiagnoseRequest {
+        window: Some(1000),
+        ..quick()
+    };
+    let d = diagnose(&record(&sticky), &req).unwrap();
+    assert_eq!(d.windows.len(), 3);
+    assert_eq!(d.windows[0].start, 0);
+    assert_eq!(d.windows[2].end, 3000);
+    for w in &d.windows {
+        assert_eq!(w.verdict, Verdict::Stiction, "{w:?}");
+        assert!(w.votes.iter().any(|v| v.1 == Vote::Stiction));
+    }
+    let bad = DiagnoseRequest {
+        window: Some(5),
+        ..quick()
+    };
+    assert!(diagnose(&record(&sticky), &bad).is_err());
+    let mut r = record(&sticky);
+    let short = &sticky.pv[..10];
+    r.pv = short;
+    assert!(diagnose(&r, &quick()).is_err());
+}
