@@ -1,5 +1,6 @@
 //! Spectral tools for stiction diagnosis: FFT-based correlation functions, a zero-phase band-pass
-//! filter and the bicoherence test of non-Gaussianity and non-linearity.
+//! filter, the bicoherence test of non-Gaussianity and non-linearity, and the PV-OP ellipse fit
+//! that measures apparent stiction.
 //!
 //! - Correlations are computed through zero-padded FFTs (O(n log n)), so a whole record of
 //!   routine data costs milliseconds; they equal the direct sums to rounding.
@@ -11,6 +12,10 @@
 //!   "Diagnosis of Process Nonlinearities and Valve Stiction" (Springer): a linear loop driven by
 //!   Gaussian noise has zero bicoherence; a sticky valve couples the phases of the oscillation's
 //!   harmonics, which shows as large squared bicoherence.
+//! - [`fit_ellipse`] is the direct least-squares ellipse fit of Fitzgibbon, Pilu and Fisher (1999)
+//!   in the numerically stable form of Halíř and Flusser (1998); [`apparent_stiction_ellipse`]
+//!   applies it to the band-passed PV-OP plot as Choudhury et al. (2006, 2008) do to quantify
+//!   apparent stiction.
 
 // `!(x > 0.0)` and the like are deliberate: they reject NaN along with the out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -415,6 +420,330 @@ pub fn bicoherence(x: &[f64], s: &BicoherenceSettings) -> Option<Bicoherence> {
     })
 }
 
+// ---------------------------------------------------------------------------------------------
+// Ellipse fit
+
+/// An ellipse fitted to a PV-OP plot (x = OP, y = PV), in the data's units.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Ellipse {
+    pub centre: [f64; 2],
+    pub semi_major: f64,
+    pub semi_minor: f64,
+    /// Angle of the major axis from the x (OP) axis, radians, in (−π/2, π/2].
+    pub angle: f64,
+    /// The chord parallel to x through the centre, `2ab / sqrt(a² sin²α + b² cos²α)`: the apparent
+    /// stiction when x is OP (Choudhury et al. 2006).
+    pub width_along_x: f64,
+    /// Root mean square of the points' (shortest, geometric) distance to the ellipse, data units.
+    pub rms_residual: f64,
+}
+
+type Mat3 = [[f64; 3]; 3];
+
+fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
+    let mut c = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            c[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    c
+}
+
+fn transpose(a: &Mat3) -> Mat3 {
+    let mut t = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            t[i][j] = a[j][i];
+        }
+    }
+    t
+}
+
+/// Lower Cholesky factor of a symmetric positive-definite matrix; `None` if a pivot is not
+/// clearly positive.
+fn cholesky(a: &Mat3) -> Option<Mat3> {
+    let scale = a[0][0].abs().max(a[1][1].abs()).max(a[2][2].abs());
+    let mut l = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..=i {
+            let s = a[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
+            if i == j {
+                if !(s > 1e-13 * scale) {
+                    return None;
+                }
+                l[i][i] = s.sqrt();
+            } else {
+                l[i][j] = s / l[j][j];
+            }
+        }
+    }
+    Some(l)
+}
+
+/// Inverse of a lower-triangular matrix.
+fn lower_inverse(l: &Mat3) -> Mat3 {
+    let mut inv = [[0.0; 3]; 3];
+    for j in 0..3 {
+        inv[j][j] = 1.0 / l[j][j];
+        for i in j + 1..3 {
+            let s: f64 = (j..i).map(|k| l[i][k] * inv[k][j]).sum();
+            inv[i][j] = -s / l[i][i];
+        }
+    }
+    inv
+}
+
+/// Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations: eigenvalues and the
+/// eigenvectors as columns.
+fn symmetric_eigen(mut a: Mat3) -> ([f64; 3], Mat3) {
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _sweep in 0..50 {
+        let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
+        let diag = a[0][0].abs() + a[1][1].abs() + a[2][2].abs();
+        if !(off > 1e-300 + 1e-16 * diag) {
+            break;
+        }
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            // signum(0) = 1: a 45° rotation for equal diagonal entries
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let c = 1.0 / (t * t + 1.0).sqrt();
+            let s = t * c;
+            // A <- Jᵀ A J and V <- V J: columns of A and V first, then rows p and q of A (p < q)
+            for row in a.iter_mut().chain(v.iter_mut()) {
+                let (rp, rq) = (row[p], row[q]);
+                row[p] = c * rp - s * rq;
+                row[q] = s * rp + c * rq;
+            }
+            let (top, bottom) = a.split_at_mut(q);
+            for (ap, aq) in top[p].iter_mut().zip(bottom[0].iter_mut()) {
+                let (rp, rq) = (*ap, *aq);
+                *ap = c * rp - s * rq;
+                *aq = s * rp + c * rq;
+            }
+        }
+    }
+    ([a[0][0], a[1][1], a[2][2]], v)
+}
+
+/// Inverse of a symmetric positive-definite 3x3 matrix via its Cholesky factor.
+fn spd_inverse(a: &Mat3) -> Option<Mat3> {
+    let li = lower_inverse(&cholesky(a)?);
+    Some(mat_mul(&transpose(&li), &li))
+}
+
+/// Direct least-squares ellipse fit (Fitzgibbon, Pilu and Fisher 1999) in the numerically
+/// stable form of Halíř and Flusser (1998): minimise the algebraic distance of the conic
+/// `A x² + B xy + C y² + D x + E y + F = 0` under the constraint `4AC − B² = 1`, which makes an
+/// ellipse the only possible answer, non-iteratively.
+///
+/// The data are centred and scaled to unit standard deviation first (the scatter matrix of raw
+/// PV-OP data in % spans many orders of magnitude), the conic is mapped back. The linear part is
+/// eliminated through `T = −S3⁻¹ S2ᵀ`, leaving the 3x3 generalised eigenproblem
+/// `(S1 + S2 T) a = λ C a`, solved here as a symmetric one through the Cholesky factor of the
+/// reduced scatter matrix (a tiny ridge keeps it definite when the points lie exactly on a
+/// conic); the one eigenvector with `4AC − B² > 0` is the ellipse.
+///
+/// Pairs beyond the shorter slice are ignored. `None` with fewer than 6 points, non-finite values,
+/// points on a line (or a point), or a conic that is not a real ellipse.
+pub fn fit_ellipse(x: &[f64], y: &[f64]) -> Option<Ellipse> {
+    let n = x.len().min(y.len());
+    let (x, y) = (&x[..n], &y[..n]);
+    if n < 6 || x.iter().chain(y).any(|v| !v.is_finite()) {
+        return None;
+    }
+    let (mx, my) = (mean(x), mean(y));
+    let sd =
+        |v: &[f64], m: f64| (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / n as f64).sqrt();
+    let (sx, sy) = (sd(x, mx), sd(y, my));
+    if !(sx > 1e-12 * mx.abs()) || !(sy > 1e-12 * my.abs()) {
+        return None;
+    }
+    // scatter matrices of D1 = [u², uv, v²] and D2 = [u, v, 1]
+    let (mut s1, mut s2, mut s3) = ([[0.0; 3]; 3], [[0.0; 3]; 3], [[0.0; 3]; 3]);
+    for (&xi, &yi) in x.iter().zip(y) {
+        let (u, v) = ((xi - mx) / sx, (yi - my) / sy);
+        let d1 = [u * u, u * v, v * v];
+        let d2 = [u, v, 1.0];
+        for i in 0..3 {
+            for j in 0..3 {
+                s1[i][j] += d1[i] * d1[j];
+                s2[i][j] += d1[i] * d2[j];
+                s3[i][j] += d2[i] * d2[j];
+            }
+        }
+    }
+    let s3_inv = spd_inverse(&s3)?; // fails for collinear points
+    let mut t = mat_mul(&s3_inv, &transpose(&s2));
+    for row in &mut t {
+        for v in row.iter_mut() {
+            *v = -*v;
+        }
+    }
+    let s2t = mat_mul(&s2, &t);
+    let mut m = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] = s1[i][j] + 0.5 * (s2t[i][j] + s2t[j][i]);
+        }
+    }
+    let ridge = 1e-12 * (m[0][0] + m[1][1] + m[2][2]);
+    for (i, row) in m.iter_mut().enumerate() {
+        row[i] += ridge;
+    }
+    // M a = λ C a  <=>  (L⁻¹ C L⁻ᵀ) b = (1/λ) b with M = L Lᵀ, b = Lᵀ a; C has exactly one
+    // positive eigenvalue, so (by Sylvester's law of inertia) has L⁻¹ C L⁻ᵀ, and its eigenvector
+    // is the one with aᵀ C a = 4AC − B² > 0.
+    let li = lower_inverse(&cholesky(&m)?);
+    let c = [[0.0, 0.0, 2.0], [0.0, -1.0, 0.0], [2.0, 0.0, 0.0]];
+    let k = mat_mul(&mat_mul(&li, &c), &transpose(&li));
+    let (values, vectors) = symmetric_eigen(k);
+    let best = (0..3).max_by(|&i, &j| values[i].total_cmp(&values[j]))?;
+    if !(values[best] > 0.0) {
+        return None;
+    }
+    let b = [vectors[0][best], vectors[1][best], vectors[2][best]];
+    let lit = transpose(&li);
+    let a1: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| lit[i][j] * b[j]).sum());
+    let a2: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| t[i][j] * a1[j]).sum());
+    // back to centred data coordinates (x - mx, y - my)
+    let conic = [
+        a1[0] / (sx * sx),
+        a1[1] / (sx * sy),
+        a1[2] / (sy * sy),
+        a2[0] / sx,
+        a2[1] / sy,
+        a2[2],
+    ];
+    let mut e = ellipse_from_conic(conic)?;
+    let (sin, cos) = e.angle.sin_cos();
+    let sq: f64 = x
+        .iter()
+        .zip(y)
+        .map(|(&xi, &yi)| {
+            // in the ellipse's own axes
+            let (u, v) = (xi - mx - e.centre[0], yi - my - e.centre[1]);
+            let d = distance_to_ellipse(
+                e.semi_major,
+                e.semi_minor,
+                u * cos + v * sin,
+                v * cos - u * sin,
+            );
+            d * d
+        })
+        .sum();
+    e.rms_residual = (sq / n as f64).sqrt();
+    e.centre[0] += mx;
+    e.centre[1] += my;
+    Some(e)
+}
+
+/// Centre, axes and angle of the conic `a x² + b xy + c y² + d x + e y + f = 0`, if it is a real
+/// ellipse. `rms_residual` is left at 0.
+fn ellipse_from_conic([a, b, c, d, e, f]: [f64; 6]) -> Option<Ellipse> {
+    let det = 4.0 * a * c - b * b;
+    if !(det > 0.0) {
+        return None;
+    }
+    let x0 = (b * e - 2.0 * c * d) / det;
+    let y0 = (b * d - 2.0 * a * e) / det;
+    // value at the centre; make the quadratic form positive definite
+    let mut f0 = f + 0.5 * (d * x0 + e * y0);
+    let (mut a, mut b, mut c) = (a, b, c);
+    if a < 0.0 {
+        (a, b, c, f0) = (-a, -b, -c, -f0);
+    }
+    if !(f0 < 0.0) {
+        return None;
+    }
+    let mid = 0.5 * (a + c);
+    let r = (0.25 * (a - c) * (a - c) + 0.25 * b * b).sqrt();
+    let (small, large) = (mid - r, mid + r);
+    if !(small > 0.0) {
+        return None;
+    }
+    // 0.5 atan2(b, a - c) is the direction of the larger eigenvalue (the minor axis)
+    let minor_dir = if r > 1e-15 * mid {
+        0.5 * b.atan2(a - c)
+    } else {
+        0.0
+    };
+    let mut angle = minor_dir + std::f64::consts::FRAC_PI_2;
+    if angle > std::f64::consts::FRAC_PI_2 {
+        angle -= std::f64::consts::PI;
+    }
+    let semi_major = (-f0 / small).sqrt();
+    let semi_minor = (-f0 / large).sqrt();
+    Some(Ellipse {
+        centre: [x0, y0],
+        semi_major,
+        semi_minor,
+        angle,
+        width_along_x: 2.0 * (-f0 / a).sqrt(),
+        rms_residual: 0.0,
+    })
+}
+
+/// Shortest distance from the point (p0, p1) to the ellipse `(x/a)² + (y/b)² = 1`, `a >= b > 0`
+/// (Eberly, "Distance from a point to an ellipse": the closest point solves a monotone equation
+/// in one unknown, found by bisection, which cannot fail).
+fn distance_to_ellipse(a: f64, b: f64, p0: f64, p1: f64) -> f64 {
+    let (y0, y1) = (p0.abs(), p1.abs());
+    if y1 > 0.0 {
+        if y0 > 0.0 {
+            let (z0, z1) = (y0 / a, y1 / b);
+            let g = z0 * z0 + z1 * z1 - 1.0;
+            if g == 0.0 {
+                return 0.0;
+            }
+            let r0 = (a / b) * (a / b);
+            let n0 = r0 * z0;
+            let (mut lo, mut hi) = (z1 - 1.0, if g < 0.0 { 0.0 } else { n0.hypot(z1) - 1.0 });
+            let mut t = lo;
+            for _ in 0..200 {
+                t = 0.5 * (lo + hi);
+                if t == lo || t == hi {
+                    break;
+                }
+                let (q0, q1) = (n0 / (t + r0), z1 / (t + 1.0));
+                let gt = q0 * q0 + q1 * q1 - 1.0;
+                if gt > 0.0 {
+                    lo = t;
+                } else if gt < 0.0 {
+                    hi = t;
+                } else {
+                    break;
+                }
+            }
+            let (x0, x1) = (r0 * y0 / (t + r0), y1 / (t + 1.0));
+            (x0 - y0).hypot(x1 - y1)
+        } else {
+            (y1 - b).abs()
+        }
+    } else {
+        let (numer, denom) = (a * y0, a * a - b * b);
+        if numer < denom {
+            let xa = numer / denom;
+            (a * xa - y0).hypot(b * (1.0 - xa * xa).sqrt())
+        } else {
+            (y0 - a).abs()
+        }
+    }
+}
+
+/// Apparent stiction from routine data (Choudhury, Shah, Thornhill and Shook 2006; book 2008):
+/// band-pass OP and PV to the oscillation's band `[low, high]` (cycles per sample, with
+/// [`band_pass`], which has no phase shift) and fit an ellipse to the PV-OP plot (x = OP,
+/// y = PV). The ellipse's width along OP is the apparent stiction, in OP's units: the stiction as
+/// the loop sees it, which with a PI controller is not the valve's `d` itself.
+pub fn apparent_stiction_ellipse(op: &[f64], pv: &[f64], low: f64, high: f64) -> Option<Ellipse> {
+    fit_ellipse(&band_pass(op, low, high), &band_pass(pv, low, high))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -634,5 +963,107 @@ mod tests {
             ..s
         };
         assert_eq!(bicoherence(&white(4096, 3), &odd).unwrap().segments, 32);
+    }
+
+    fn ellipse_points(n: usize, noise: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
+        let (a, b, alpha) = (5.0, 2.0, 0.5f64);
+        let mut rng = seeded(seed);
+        (0..n)
+            .map(|i| {
+                let t = TAU * i as f64 / n as f64;
+                let (u, v) = (a * t.cos(), b * t.sin());
+                (
+                    50.0 + u * alpha.cos() - v * alpha.sin() + noise * gaussian(&mut rng),
+                    20.0 + u * alpha.sin() + v * alpha.cos() + noise * gaussian(&mut rng),
+                )
+            })
+            .unzip()
+    }
+
+    #[test]
+    fn ellipse_fit_recovers_a_rotated_ellipse() {
+        let (a, b, alpha) = (5.0f64, 2.0f64, 0.5f64);
+        let width =
+            2.0 * a * b / (a * a * alpha.sin().powi(2) + b * b * alpha.cos().powi(2)).sqrt();
+        for (noise, tol) in [(0.0, 1e-9), (0.02, 0.01)] {
+            let (x, y) = ellipse_points(400, noise, 3);
+            let e = fit_ellipse(&x, &y).unwrap();
+            let rel = |got: f64, want: f64| ((got - want) / want).abs();
+            assert!(
+                rel(e.centre[0], 50.0) < tol && rel(e.centre[1], 20.0) < tol,
+                "{e:?}"
+            );
+            assert!(
+                rel(e.semi_major, a) < tol && rel(e.semi_minor, b) < tol,
+                "{e:?}"
+            );
+            assert!(rel(e.angle, alpha) < tol, "{e:?}");
+            assert!(rel(e.width_along_x, width) < tol, "{e:?}");
+            assert!(e.rms_residual < 2.0 * noise + 1e-9, "{e:?}");
+        }
+        // the same ellipse turned by -0.5 rad: the angle keeps its sign
+        let (x, y) = ellipse_points(200, 0.0, 4);
+        let y: Vec<f64> = y.iter().map(|v| 40.0 - v).collect();
+        let e = fit_ellipse(&x, &y).unwrap();
+        assert!((e.angle + alpha).abs() < 1e-9, "{e:?}");
+    }
+
+    #[test]
+    fn distance_to_an_ellipse() {
+        // brute force over a fine parametrisation
+        let (a, b) = (5.0, 2.0);
+        for (p0, p1) in [
+            (0.0, 0.0),
+            (6.0, 0.0),
+            (1.0, 0.0),
+            (0.0, -3.0),
+            (3.0, 1.0),
+            (-4.0, 2.5),
+            (0.3, 0.1),
+        ] {
+            let brute = (0..200_000)
+                .map(|i| {
+                    let t = TAU * i as f64 / 200_000.0;
+                    (a * t.cos() - p0).hypot(b * t.sin() - p1)
+                })
+                .fold(f64::INFINITY, f64::min);
+            let d = distance_to_ellipse(a, b, p0, p1);
+            assert!((d - brute).abs() < 1e-6, "({p0}, {p1}): {d} vs {brute}");
+        }
+    }
+
+    #[test]
+    fn ellipse_fit_rejects_degenerate_data() {
+        let x: Vec<f64> = (0..50).map(|i| i as f64).collect();
+        let line: Vec<f64> = x.iter().map(|v| 2.0 * v + 1.0).collect();
+        assert!(fit_ellipse(&x, &line).is_none());
+        // a noisy line: no ellipse, or a very thin one
+        let noisy: Vec<f64> = line
+            .iter()
+            .zip(white(50, 5))
+            .map(|(v, n)| v + 0.01 * n)
+            .collect();
+        if let Some(e) = fit_ellipse(&x, &noisy) {
+            assert!(e.semi_minor < 0.01 * e.semi_major, "{e:?}");
+        }
+        assert!(fit_ellipse(&x, &[3.0; 50]).is_none());
+        assert!(fit_ellipse(&[1.0, 2.0, 3.0], &[1.0, 0.0, 1.0]).is_none());
+        assert!(fit_ellipse(&[], &[]).is_none());
+        let (mut ex, ey) = ellipse_points(100, 0.0, 6);
+        ex[3] = f64::INFINITY;
+        assert!(fit_ellipse(&ex, &ey).is_none());
+    }
+
+    #[test]
+    fn apparent_stiction_of_a_sticky_loop() {
+        let data = sticky_loop(2.0, None, 1);
+        let (op, pv) = (&data.op[200..], &data.pv[200..]);
+        let period = crate::detect::regularity(&control_error(&data), 1.0)
+            .period
+            .unwrap();
+        let f = 1.0 / period;
+        let e = apparent_stiction_ellipse(op, pv, 0.5 * f, 1.5 * f).unwrap();
+        // the apparent stiction is of the order of d (2.1-2.2 here for d = 2)
+        assert!(e.width_along_x > 1.0 && e.width_along_x < 4.0, "{e:?}");
     }
 }
