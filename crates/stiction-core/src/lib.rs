@@ -13,6 +13,7 @@ pub mod quantify;
 pub mod reproduce;
 pub mod rng;
 pub mod sim;
+pub mod spectral;
 
 pub use estimate::{estimate, Estimate, Method, Request};
 pub use models::{Model, ModelKind, StictionModel};
