@@ -29,25 +29,13 @@ pub const REGULARITY_THRESHOLD: f64 = 1.0;
 /// Zero crossings of the autocorrelation used for the periods (about five periods).
 pub const MAX_CROSSINGS: usize = 11;
 
-/// Autocorrelation of a mean-free copy of `x` for lags `0..=max_lag` (biased estimator, so r(0) = 1).
+/// Autocorrelation of a mean-free copy of `x` for lags `0..=max_lag` (biased estimator, so r(0) = 1;
+/// all zeros for a constant). Computed by FFT.
 pub fn autocorrelation(x: &[f64], max_lag: usize) -> Vec<f64> {
-    let n = x.len();
-    let mean = x.iter().sum::<f64>() / n.max(1) as f64;
-    let c: Vec<f64> = x.iter().map(|v| v - mean).collect();
-    let var: f64 = c.iter().map(|v| v * v).sum();
-    if var <= 0.0 {
-        return vec![0.0; max_lag.min(n.saturating_sub(1)) + 1];
+    if x.is_empty() {
+        return vec![0.0];
     }
-    (0..=max_lag.min(n.saturating_sub(1)))
-        .map(|k| {
-            c[..n - k]
-                .iter()
-                .zip(&c[k..])
-                .map(|(a, b)| a * b)
-                .sum::<f64>()
-                / var
-        })
-        .collect()
+    crate::spectral::autocorrelation(x, max_lag)
 }
 
 /// Regularity of the oscillation in `error` sampled every `ts` seconds.
@@ -170,37 +158,11 @@ pub struct CrossCorrelation {
 }
 
 /// Cross-correlation of `op` with `pv` at lags `-max_lag..=max_lag` (index `max_lag` is lag 0;
-/// positive lags: pv after op).
+/// positive lags: pv after op). Computed by FFT.
 pub fn cross_correlation(op: &[f64], pv: &[f64], max_lag: usize) -> Vec<f64> {
     let n = op.len().min(pv.len());
-    let mean = |v: &[f64]| v[..n].iter().sum::<f64>() / n.max(1) as f64;
-    let (mu, my) = (mean(op), mean(pv));
-    let u: Vec<f64> = op[..n].iter().map(|v| v - mu).collect();
-    let y: Vec<f64> = pv[..n].iter().map(|v| v - my).collect();
-    let norm = (u.iter().map(|v| v * v).sum::<f64>() * y.iter().map(|v| v * v).sum::<f64>()).sqrt();
     let lag = max_lag.min(n.saturating_sub(1));
-    (0..=2 * lag)
-        .map(|i| {
-            let k = i as isize - lag as isize;
-            if norm <= 0.0 {
-                return 0.0;
-            }
-            let sum: f64 = if k >= 0 {
-                u[..n - k as usize]
-                    .iter()
-                    .zip(&y[k as usize..])
-                    .map(|(a, b)| a * b)
-                    .sum()
-            } else {
-                y[..n - (-k) as usize]
-                    .iter()
-                    .zip(&u[(-k) as usize..])
-                    .map(|(a, b)| a * b)
-                    .sum()
-            };
-            sum / norm
-        })
-        .collect()
+    crate::spectral::cross_correlation(&op[..n], &pv[..n], lag)
 }
 
 /// Horch's test: the OP-PV cross-correlation is odd for a sticky valve in a self-regulating loop

@@ -10,6 +10,7 @@
 use crate::detect::{self, CrossCorrelation, IaeCount, IaeSettings, Regularity, ShapeIndex};
 use crate::quality::{self, Finding, Limits, Record};
 use crate::quantify::{quantify, Quantification, QuantifyRequest};
+use crate::spectral::{self, BicoherenceSettings};
 use crate::{Method, ModelKind};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -484,6 +485,7 @@ fn indices(
         let c = detect::horch(op, pv, ts, (period_samples).max(10).min(op.len() / 2));
         out.push(horch_index(&c));
     }
+    out.push(bicoherence_index(error));
     let op_s = smooth(op, w);
     let pv_s = smooth(pv, w);
     let e_s = smooth(error, w);
@@ -520,6 +522,55 @@ fn indices(
         "the control error",
     ));
     out
+}
+
+/// Choudhury, Shah and Thornhill (2004): the squared bicoherence of the control error; a
+/// non-Gaussian (NGI) and non-linear (NLI) error points to a non-linearity in the loop, most often
+/// the valve; a Gaussian one to a linear cause. Reported with its vote but weight 0 in the verdict:
+/// on our benchmark (docs/diagnose-benchmark.md) it did not separate stiction from other causes,
+/// raw, band-passed around the oscillation, or decimated (the records are short for 128-sample
+/// segments and their oscillations slow).
+fn bicoherence_index(error: &[f64]) -> Index {
+    let x = error;
+    let settings = BicoherenceSettings::default();
+    let b = spectral::bicoherence(x, &settings);
+    let reference = "Choudhury, Shah and Thornhill (2004): bicoherence of the control error".into();
+    let threshold = format!(
+        "non-Gaussian when NGI > {}, then non-linear (stiction-like) when NLI > {}; Gaussian: linear cause",
+        settings.ngi_threshold, settings.nli_threshold
+    );
+    match b {
+        None => Index {
+            name: "bicoherence".into(),
+            reference,
+            value: None,
+            threshold,
+            vote: Vote::Undetermined,
+            weight: 0.0,
+            note: format!(
+                "too few samples for {} segments",
+                spectral::MIN_SEGMENTS
+            ),
+        },
+        Some(b) => Index {
+            name: "bicoherence".into(),
+            reference,
+            value: Some(b.ngi),
+            threshold,
+            vote: if b.non_linear {
+                Vote::Stiction
+            } else if !b.non_gaussian {
+                Vote::NoStiction
+            } else {
+                Vote::Undetermined
+            },
+            weight: 0.0,
+            note: format!(
+                "NGI {:.4}, NLI {:.3} ({} segments of {}); value shown: NGI; not counted in the verdict",
+                b.ngi, b.nli, b.segments, b.segment_length
+            ),
+        },
+    }
 }
 
 /// Combine the votes: a weighted mean of +1 (stiction), -1 (no stiction), 0 (undetermined).
@@ -728,6 +779,28 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
     }
     let mut apparent = None;
     let mut quantification = None;
+    if stretch.verdict == Verdict::Stiction {
+        // the ellipse through the PV-OP plot filtered around the oscillation (Choudhury et al.)
+        let ellipse = stretch
+            .oscillation
+            .as_ref()
+            .and_then(|o| o.period)
+            .and_then(|p| {
+                let f0 = req.ts / p;
+                spectral::apparent_stiction_ellipse(
+                    &r.op[s..e],
+                    &r.pv[s..e],
+                    0.5 * f0,
+                    (1.5 * f0).min(0.5),
+                )
+            })
+            .map(|el| el.width_along_x);
+        apparent = Some(ApparentStiction {
+            closed_loop: None,
+            closed_loop_interval: None,
+            ellipse,
+        });
+    }
     if stretch.verdict == Verdict::Stiction && req.quantify {
         let mut q = QuantifyRequest::new(ModelKind::Stenman, Method::Exact);
         q.ts = req.ts;
@@ -735,11 +808,10 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
         q.integrating = req.integrating.then_some(true);
         match quantify(&r.op[s..e], &r.pv[s..e], &q) {
             Ok(qr) => {
-                apparent = Some(ApparentStiction {
-                    closed_loop: qr.apparent_stiction,
-                    closed_loop_interval: qr.interval.get("d").copied(),
-                    ellipse: None,
-                });
+                if let Some(a) = apparent.as_mut() {
+                    a.closed_loop = qr.apparent_stiction;
+                    a.closed_loop_interval = qr.interval.get("d").copied();
+                }
                 quantification = Some(qr);
             }
             Err(err) => warnings.push(format!("the closed-loop estimate failed: {err}")),
