@@ -198,7 +198,7 @@ fn num(v: f64) -> String {
     let a = v.abs();
     let s = if a == 0.0 {
         "0".to_string()
-    } else if a >= 1e6 || a < 1e-3 {
+    } else if !(1e-3..1e6).contains(&a) {
         format!("{v:.3e}")
     } else if a >= 1000.0 {
         format!("{v:.0}")
@@ -316,7 +316,7 @@ fn headroom(series: &[Series], top: f64) -> Option<(f64, f64)> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    (hi > lo).then(|| (lo, hi + top * (hi - lo)))
+    (hi > lo).then_some((lo, hi + top * (hi - lo)))
 }
 
 fn figure(h: &mut String, chart: &Chart, sizes: [(u32, u32); 2], caption: &str) -> Result<()> {
