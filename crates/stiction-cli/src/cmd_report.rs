@@ -242,6 +242,19 @@ fn time_axis(lf: &LoopFile) -> Vec<f64> {
     }
 }
 
+/// The unit the trends' time axis reads best in: its name and seconds per unit.
+fn time_unit(span: f64) -> (&'static str, f64) {
+    if span > 2.0 * 86400.0 {
+        ("d", 86400.0)
+    } else if span > 5.0 * 3600.0 {
+        ("h", 3600.0)
+    } else if span > 3000.0 {
+        ("min", 60.0)
+    } else {
+        ("s", 1.0)
+    }
+}
+
 /// The first, lowest and highest sample of each of `buckets` buckets, in time order.
 fn decimate(x: &[f64], y: &[f64], buckets: usize) -> (Vec<f64>, Vec<f64>) {
     let n = x.len().min(y.len());
@@ -407,7 +420,9 @@ fn verdict_box(h: &mut String, d: &Diagnosis) {
             esc(r)
         );
     }
-    if !d.evidence.is_empty() {
+    // for insufficient data and a loop without oscillation the evidence repeats the reason
+    let repeats_reason = matches!((d.evidence.as_slice(), &d.reason), ([e], Some(r)) if e == r);
+    if !d.evidence.is_empty() && !repeats_reason {
         h.push_str("<p><strong>Evidence</strong></p>\n<ul>\n");
         for e in &d.evidence {
             let _ = writeln!(h, "<li>{}</li>", esc(e));
@@ -434,17 +449,20 @@ fn verdict_box(h: &mut String, d: &Diagnosis) {
 fn trends(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<()> {
     h.push_str("<section id=\"trends\">\n<h2>Trends</h2>\n");
     let t = time_axis(lf);
+    let (unit, per) = time_unit(t.last().copied().unwrap_or(0.0));
+    let x_label = format!("time ({unit})");
+    let tu: Vec<f64> = t.iter().map(|v| v / per).collect();
     let [s, e] = d.analysed;
     let stretch = s < e && e <= t.len();
-    let (tp, pv) = decimate(&t, &lf.pv, TREND_BUCKETS);
-    let sp = lf.sp.as_ref().map(|sp| decimate(&t, sp, TREND_BUCKETS));
+    let (tp, pv) = decimate(&tu, &lf.pv, TREND_BUCKETS);
+    let sp = lf.sp.as_ref().map(|sp| decimate(&tu, sp, TREND_BUCKETS));
     // the fitted model and the estimated valve cover the analysed stretch only
     let sim = q
         .filter(|q| stretch && q.pv_simulated.len() == e - s)
-        .map(|q| decimate(&t[s..e], &q.pv_simulated, TREND_BUCKETS));
+        .map(|q| decimate(&tu[s..e], &q.pv_simulated, TREND_BUCKETS));
     let mv = q
         .filter(|q| stretch && q.mv.len() == e - s)
-        .map(|q| decimate(&t[s..e], &q.mv, TREND_BUCKETS));
+        .map(|q| decimate(&tu[s..e], &q.mv, TREND_BUCKETS));
     let mut series = vec![Series {
         label: "PV".into(),
         x: &tp,
@@ -475,7 +493,7 @@ fn trends(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantificatio
     }
     let chart = Chart {
         title: "Process variable".into(),
-        x_label: "time (s)".into(),
+        x_label: x_label.clone(),
         y_label: "PV".into(),
         y_range: headroom(&series, 0.45),
         series,
@@ -493,7 +511,7 @@ fn trends(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantificatio
     caption.push('.');
     figure(h, &chart, TREND_SIZE, &caption)?;
 
-    let (to, op) = decimate(&t, &lf.op, TREND_BUCKETS);
+    let (to, op) = decimate(&tu, &lf.op, TREND_BUCKETS);
     let mut series = vec![Series {
         label: "OP".into(),
         x: &to,
@@ -514,7 +532,7 @@ fn trends(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantificatio
     }
     let chart = Chart {
         title: "Controller output".into(),
-        x_label: "time (s)".into(),
+        x_label,
         y_label: "OP".into(),
         y_range: headroom(&series, 0.35),
         series,
@@ -522,7 +540,7 @@ fn trends(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantificatio
     };
     let caption = if mv.is_some() {
         "Controller output and, in red, the valve position the fitted stiction model estimates \
-         (the valve is not measured: it sticks while OP moves less than the band)."
+         (the valve is not measured: it holds until OP has moved more than the band away from it)."
     } else {
         "Controller output."
     };
@@ -919,18 +937,23 @@ fn windows(h: &mut String, d: &Diagnosis) {
     timeline(h, &d.windows, d.samples);
     h.push_str(
         "<div class=\"scroll\"><table class=\"wide\">\n<thead><tr><th>Samples</th><th>Time (s)</th>\
-         <th>Verdict</th><th>Confidence</th><th>Period</th><th>Votes</th><th>Reason</th></tr></thead>\n<tbody>\n",
+         <th>Verdict</th><th>Confidence</th><th>Period</th><th>Votes</th>",
     );
+    let reasons = d.windows.iter().any(|w| w.reason.is_some());
+    if reasons {
+        h.push_str("<th>Reason</th>");
+    }
+    h.push_str("</tr></thead>\n<tbody>\n");
     for w in &d.windows {
         let votes: Vec<String> = w
             .votes
             .iter()
             .map(|(n, v)| format!("<code>{}</code> {}", esc(n), vote_chip(*v)))
             .collect();
-        let _ = writeln!(
+        let _ = write!(
             h,
             "<tr><td class=\"num\">{} to {}</td><td class=\"num\">{} to {}</td><td>{}</td>\
-             <td class=\"num\">{:.2}</td><td class=\"num\">{}</td><td>{}</td><td class=\"text\">{}</td></tr>",
+             <td class=\"num\">{:.2}</td><td class=\"num\">{}</td><td>{}</td>",
             w.start,
             w.end,
             num(w.t_start),
@@ -943,8 +966,15 @@ fn windows(h: &mut String, d: &Diagnosis) {
             } else {
                 votes.join("<br>")
             },
-            esc(w.reason.as_deref().unwrap_or(""))
         );
+        if reasons {
+            let _ = write!(
+                h,
+                "<td class=\"text\">{}</td>",
+                esc(w.reason.as_deref().unwrap_or(""))
+            );
+        }
+        h.push_str("</tr>\n");
     }
     h.push_str("</tbody></table></div>\n</section>\n");
 }
