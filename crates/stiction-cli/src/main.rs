@@ -5,6 +5,7 @@
 mod cmd_diagnose;
 mod cmd_estimate;
 mod cmd_quantify;
+mod cmd_report;
 mod cmd_reproduce;
 mod cmd_simulate;
 mod data;
@@ -39,6 +40,8 @@ enum Command {
     Quantify(cmd_quantify::Args),
     /// Diagnose a loop from routine data: quality gates, oscillation, stiction indices and a verdict.
     Diagnose(cmd_diagnose::Args),
+    /// Diagnose a loop and write one self-contained HTML report (inline SVG charts, no network).
+    Report(cmd_report::Args),
     /// Reproduce published results (`stiction reproduce paper`).
     Reproduce(cmd_reproduce::Args),
 }
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::Estimate(a) => cmd_estimate::run(a),
         Command::Quantify(a) => cmd_quantify::run(a),
         Command::Diagnose(a) => cmd_diagnose::run(a),
+        Command::Report(a) => cmd_report::run(a),
         Command::Reproduce(a) => cmd_reproduce::run(a),
     };
     match result {

@@ -110,6 +110,18 @@ pub fn save_panels(charts: &[Chart], stem: &Path) -> Result<Vec<PathBuf>> {
     Ok(vec![png, svg])
 }
 
+/// One chart as an SVG document in memory (no file), `size` in SVG user units.
+pub fn svg_string(chart: &Chart, size: (u32, u32)) -> Result<String> {
+    register_font();
+    let mut out = String::new();
+    {
+        // `draw` presents the area, which closes the document into `out`
+        let area = SVGBackend::with_string(&mut out, size).into_drawing_area();
+        draw(area, chart).map_err(|e| anyhow!("cannot draw the chart '{}': {e}", chart.title))?;
+    }
+    Ok(out)
+}
+
 fn bounds(chart: &Chart) -> ((f64, f64), (f64, f64)) {
     let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
     let mut yr = xr;
