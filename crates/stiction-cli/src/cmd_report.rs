@@ -452,11 +452,11 @@ fn trends(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantificatio
     let (unit, per) = time_unit(t.last().copied().unwrap_or(0.0));
     let x_label = format!("time ({unit})");
     let tu: Vec<f64> = t.iter().map(|v| v / per).collect();
-    let [s, e] = d.analysed;
+    // the fitted model and the estimated valve cover the samples the estimate used
+    let [s, e] = d.quantified.unwrap_or(d.analysed);
     let stretch = s < e && e <= t.len();
     let (tp, pv) = decimate(&tu, &lf.pv, TREND_BUCKETS);
     let sp = lf.sp.as_ref().map(|sp| decimate(&tu, sp, TREND_BUCKETS));
-    // the fitted model and the estimated valve cover the analysed stretch only
     let sim = q
         .filter(|q| stretch && q.pv_simulated.len() == e - s)
         .map(|q| decimate(&tu[s..e], &q.pv_simulated, TREND_BUCKETS));
@@ -505,7 +505,7 @@ fn trends(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantificatio
     }
     if sim.is_some() {
         caption.push_str(
-            "; in red the PV the fitted valve-and-process model simulates from OP alone, over the analysed stretch",
+            "; in red the PV the fitted valve-and-process model simulates from OP alone, over the samples the estimate used",
         );
     }
     caption.push('.');
@@ -560,7 +560,7 @@ fn trends(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantificatio
 
 fn phase(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<()> {
     h.push_str("<section id=\"phase\">\n<h2>PV against OP</h2>\n");
-    let [s, e] = d.analysed;
+    let [s, e] = d.quantified.unwrap_or(d.analysed);
     let (s, e) = if s + 1 < e && e <= lf.op.len() {
         (s, e)
     } else {
@@ -831,6 +831,14 @@ fn convergence(h: &mut String, q: Option<&Quantification>) {
                     trajectory only at a finite set of values, so the whole range of d splits into \
                     cells with one valve trajectory each; every cell was fitted once. The optimum \
                     is proven over every distinct valve trajectory, not found by chance."
+        }
+        "exact_staged" => {
+            "The exact method does not search: the band d changes the estimated valve \
+                    trajectory only at a finite set of values, so the whole range of d splits into \
+                    cells with one valve trajectory each. Every cell of the first samples was fitted, \
+                    then, on the whole record, every cell inside the best of them (each cell of the \
+                    whole record lies inside one cell of its first samples). The optimum is proven \
+                    over every distinct valve trajectory kept, not found by chance."
         }
         "exact_local" => {
             "The exact method fitted every valve trajectory near the best points of a \

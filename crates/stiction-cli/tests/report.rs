@@ -122,6 +122,7 @@ fn report_of_a_sticky_loop_is_self_contained() {
     assert!(html.contains("PV simulated"));
     assert!(html.contains("Distinct valve trajectories (cells)"));
     assert!(html.contains("proven over every distinct valve trajectory"));
+    assert!(html.contains("each cell of the whole record lies inside"));
     assert!(html.contains("without the valve position"));
     assert!(html.contains("<code>op_saturated</code>"));
 

@@ -204,6 +204,10 @@ pub struct Diagnosis {
     pub apparent_stiction: Option<ApparentStiction>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub quantification: Option<Quantification>,
+    /// The samples `[start, end)` the closed-loop estimate used (the whole record unless its time
+    /// axis has gaps: setpoint changes and manual mode do not break the OP -> PV relation).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quantified: Option<[usize; 2]>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub windows: Vec<WindowVerdict>,
     pub warnings: Vec<String>,
@@ -779,6 +783,7 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
     }
     let mut apparent = None;
     let mut quantification = None;
+    let mut quantified = None;
     if stretch.verdict == Verdict::Stiction {
         // the ellipse through the PV-OP plot filtered around the oscillation (Choudhury et al.)
         let ellipse = stretch
@@ -806,13 +811,33 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
         q.ts = req.ts;
         q.max_delay = req.max_delay;
         q.integrating = req.integrating.then_some(true);
-        match quantify(&r.op[s..e], &r.pv[s..e], &q) {
+        // identification needs only the OP -> PV relation, which setpoint changes and manual
+        // mode do not break (they excite it): the whole record is used unless its time axis has
+        // gaps, and the valve then starts from a known state more often (its initial position
+        // is not estimated)
+        let whole_ok = r.time.is_none_or(|t| {
+            quality::check(
+                &Record {
+                    op: r.op,
+                    pv: r.pv,
+                    sp: None,
+                    time: Some(t),
+                    auto: None,
+                },
+                &req.limits,
+            )
+            .iter()
+            .all(|f| f.gate != "time_gaps" || f.passed)
+        });
+        let (qs, qe) = if whole_ok { (0, n) } else { (s, e) };
+        match quantify(&r.op[qs..qe], &r.pv[qs..qe], &q) {
             Ok(qr) => {
                 if let Some(a) = apparent.as_mut() {
                     a.closed_loop = qr.apparent_stiction;
                     a.closed_loop_interval = qr.interval.get("d").copied();
                 }
                 quantification = Some(qr);
+                quantified = Some([qs, qe]);
             }
             Err(err) => warnings.push(format!("the closed-loop estimate failed: {err}")),
         }
@@ -863,6 +888,7 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
         indices: stretch.indices,
         apparent_stiction: apparent,
         quantification,
+        quantified,
         windows,
         warnings,
         seconds: started.elapsed().as_secs_f64(),
