@@ -582,29 +582,53 @@ struct FullGram {
 impl FullGram {
     fn new(y: &[f64], mv: &[f64], na: usize, m: usize, t0: usize) -> Self {
         let p = na + m + 1;
+        let n = y.len();
         let mut g = vec![0.0; p * p];
         let mut h = vec![0.0; p];
-        let mut yy = 0.0;
-        let mut z = vec![0.0; p];
-        for t in t0..y.len() {
-            for i in 0..na {
-                z[i] = y[t - 1 - i];
+        // column k is series[t - 1 - lag] (y for k < na, mv after), the last one the constant
+        let col = |k: usize| -> (&[f64], usize) {
+            if k < na {
+                (y, k)
+            } else {
+                (mv, k - na)
             }
-            for j in 0..m {
-                z[na + j] = mv[t - 1 - j];
-            }
-            z[p - 1] = 1.0;
-            let target = y[t];
-            for i in 0..p {
-                let zi = z[i];
-                h[i] += zi * target;
-                let row = &mut g[i * p..(i + 1) * p];
-                for j in i..p {
-                    row[j] += zi * z[j];
-                }
-            }
-            yy += target * target;
+        };
+        let yy: f64 = y[t0..].iter().map(|v| v * v).sum();
+        if n <= t0 {
+            return Self { g, h, yy, p, na, m };
         }
+        // sum over t in t0..n of a[t - 1 - i] b[t - 1 - j]
+        let direct = |a: &[f64], i: usize, b: &[f64], j: usize| -> f64 {
+            a[t0 - 1 - i..n - 1 - i]
+                .iter()
+                .zip(&b[t0 - 1 - j..n - 1 - j])
+                .map(|(x, z)| x * z)
+                .sum()
+        };
+        for a in 0..p - 1 {
+            let (sa, la) = col(a);
+            h[a] = sa[t0 - 1 - la..n - 1 - la]
+                .iter()
+                .zip(&y[t0..])
+                .map(|(x, z)| x * z)
+                .sum();
+            g[a * p + p - 1] = sa[t0 - 1 - la..n - 1 - la].iter().sum();
+            for b in a..p - 1 {
+                let (sb, lb) = col(b);
+                // a lagged product shifts by one sample along a diagonal of one block: add the
+                // sample that enters, drop the one that leaves (exact up to rounding, O(1) each)
+                // (column a - 1 is column a one lag earlier unless a starts a block)
+                let shiftable = a != 0 && a != na && b != 0 && b != na;
+                g[a * p + b] = if shiftable {
+                    g[(a - 1) * p + (b - 1)] + sa[t0 - 1 - la] * sb[t0 - 1 - lb]
+                        - sa[n - 1 - la] * sb[n - 1 - lb]
+                } else {
+                    direct(sa, la, sb, lb)
+                };
+            }
+        }
+        g[(p - 1) * p + p - 1] = (n - t0) as f64;
+        h[p - 1] = y[t0..].iter().sum();
         Self { g, h, yy, p, na, m }
     }
 
