@@ -734,6 +734,26 @@ pub fn simulation_bic(data: &Data, f: &Fit) -> f64 {
     bic(f.sse_simulation, data, s.na + s.nb + 1)
 }
 
+/// BIC of the simulation error at the PV level: integrating fits (which model the PV's change)
+/// are integrated back from the measured PV at `t0`, so the two families compare on the same
+/// numbers (their own simulation errors are of different outputs).
+pub fn level_simulation_bic(data: &Data, mv: &[f64], f: &Fit) -> f64 {
+    let s = f.structure;
+    if !s.integrating {
+        return simulation_bic(data, f);
+    }
+    let sim = simulate_pv(data, mv, f);
+    let sse: f64 = sim[data.t0..]
+        .iter()
+        .zip(&data.pv[data.t0..])
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum();
+    if !sse.is_finite() {
+        return f64::INFINITY;
+    }
+    bic(sse, data, s.na + s.nb + 1)
+}
+
 /// Gain, time constant and dead time where they follow from the fitted coefficients.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Physical {

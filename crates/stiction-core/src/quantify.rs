@@ -101,6 +101,9 @@ pub struct FitQuality {
     pub r2_simulation: f64,
     pub r2_one_step: f64,
     pub sse_simulation: f64,
+    /// R² in simulation of the best linear model of the same family with a valve that follows
+    /// OP exactly (no stiction): how much of the fit the stiction model itself earns.
+    pub r2_simulation_without_stiction: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -375,11 +378,9 @@ fn quantify_inner(
     let data = Data::new(pv, search.t0());
     let mut evaluations = 0u64;
     // pilot: the process family and a first structure, chosen at a spread of stiction parameters
-    let pilots = if hint.is_some() {
-        Vec::new() // the first stage chose the structures
-    } else {
-        pilot_points(req.model, &bounds)
-    };
+    // (a staged search runs them again on the whole record: the first samples may be too few
+    // to tell the structure)
+    let pilots = pilot_points(req.model, &bounds);
     let choices: Vec<identify::Selection> = pilots
         .par_iter()
         .filter_map(|theta| {
@@ -414,11 +415,24 @@ fn quantify_inner(
         }
     }
     if let Some(h) = hint {
-        queue.extend(h.structures.iter().take(STARTING_STRUCTURES));
+        queue.extend(h.structures.iter().take(STARTING_STRUCTURES / 2));
     }
     for c in &ranked {
         if !queue.contains(&c.structure) && queue.len() < STARTING_STRUCTURES {
             queue.push_back(c.structure);
+        }
+    }
+    // the structure of a valve without stiction is always searched: the answer is then never
+    // worse than the linear loop it is compared with
+    let lows: Vec<f64> = bounds.iter().map(|b| b.0).collect();
+    if let Some(sel) = req
+        .model
+        .build(&lows)
+        .ok()
+        .and_then(|m| identify::select(&data, &identify::centred(&m.simulate(op)), &search))
+    {
+        if !queue.contains(&sel.structure) {
+            queue.push_back(sel.structure);
         }
     }
     if queue.is_empty() {
@@ -494,10 +508,10 @@ fn quantify_inner(
         // a walk shared by several structures counts once
         evaluations += outcomes.iter().map(|o| o.evaluations).max().unwrap_or(0);
         for (problem, outcome) in problems.iter().zip(outcomes) {
-            let criterion = problem
-                .fit(&outcome.best)
-                .map_or(f64::INFINITY, |f| identify::simulation_bic(&data, &f));
             let mv_c = problem.valve(&outcome.best);
+            let criterion = problem.fit(&outcome.best).map_or(f64::INFINITY, |f| {
+                identify::level_simulation_bic(&data, &mv_c, &f)
+            });
             tried.push((problem.prepared.structure(), outcome, criterion));
             evaluations += 1;
             // confirm the structure at this answer; a different one is searched next, first
@@ -542,6 +556,23 @@ fn quantify_inner(
     let pv_simulated = identify::simulate_pv(&data, &problem.valve(&outcome.best), &fit);
     let phys = identify::physical(&fit, req.ts);
     let names = req.model.param_names();
+    // the same data through a valve without stiction: the chosen structure, and the structure
+    // of the same family the search picks for it
+    let r2_without = {
+        let mv0 = problem.valve(&vec![0.0; req.model.dim()]);
+        let mut same = search.clone();
+        same.integrating = structure.integrating;
+        same.self_regulating = !structure.integrating;
+        let chosen = problem.prepared.fit(&mv0).map(|f| f.r2_simulation());
+        let reselected = identify::select(&data, &mv0, &same)
+            .and_then(|sel| identify::fit(&data, &mv0, sel.structure))
+            .map(|f| f.r2_simulation());
+        match (chosen, reselected) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        }
+        .filter(|v| v.is_finite())
+    };
     let band = match req.model {
         ModelKind::Stenman => outcome.best[0],
         ModelKind::He => outcome.best[0] + outcome.best[1],
@@ -618,6 +649,7 @@ fn quantify_inner(
                 r2_simulation: fit.r2_simulation(),
                 r2_one_step: fit.r2_one_step(),
                 sse_simulation: fit.sse_simulation,
+                r2_simulation_without_stiction: r2_without,
             }),
             apparent_stiction: Some(band),
             apparent_stiction_pct_of_op_range: Some(100.0 * band / op_range),
@@ -924,7 +956,13 @@ fn exact_stenman(
                 },
                 evaluations: (cells.len() + scan.len()) as u64,
                 cells: Some(cells.len()),
-                top_cells: ranked.iter().take(TOP_CELLS).map(|c| c.0).collect(),
+                // the best cells, and the lowest (a valve without stiction is always a candidate)
+                top_cells: ranked
+                    .iter()
+                    .take(TOP_CELLS)
+                    .map(|c| c.0)
+                    .chain(cells.first().map(|c| c.0))
+                    .collect(),
             }
         })
         .collect()
