@@ -180,11 +180,16 @@ pub fn print_human(file: &str, d: &Diagnosis) {
         println!("  indices:");
         for i in &d.indices {
             println!(
-                "    {:<18} {:>8}  {:<13} {}",
+                "    {:<18} {:>8}  {:<13} {}{}",
                 i.name,
                 i.value.map_or("-".into(), |v| format!("{v:.3}")),
                 vote_word(i.vote),
-                i.threshold
+                i.threshold,
+                if i.weight == 0.0 {
+                    " [shown, not counted]"
+                } else {
+                    ""
+                }
             );
         }
     }

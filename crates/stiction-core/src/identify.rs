@@ -568,6 +568,27 @@ pub fn simulate_pv(data: &Data, mv: &[f64], f: &Fit) -> Vec<f64> {
     }
 }
 
+/// A dot product with four running sums: the additions of one sum wait for each other, four
+/// sums keep the pipeline full (the order is fixed, so the result is reproducible).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let chunks = n / 4;
+    for k in 0..chunks {
+        let i = 4 * k;
+        acc[0] += a[i] * b[i];
+        acc[1] += a[i + 1] * b[i + 1];
+        acc[2] += a[i + 2] * b[i + 2];
+        acc[3] += a[i + 3] * b[i + 3];
+    }
+    let mut tail = 0.0;
+    for i in 4 * chunks..n {
+        tail += a[i] * b[i];
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
 /// The full regressor set of a search, accumulated once per valve trajectory: every structure is
 /// then a sub-matrix, solved in microseconds.
 struct FullGram {
@@ -599,19 +620,11 @@ impl FullGram {
         }
         // sum over t in t0..n of a[t - 1 - i] b[t - 1 - j]
         let direct = |a: &[f64], i: usize, b: &[f64], j: usize| -> f64 {
-            a[t0 - 1 - i..n - 1 - i]
-                .iter()
-                .zip(&b[t0 - 1 - j..n - 1 - j])
-                .map(|(x, z)| x * z)
-                .sum()
+            dot(&a[t0 - 1 - i..n - 1 - i], &b[t0 - 1 - j..n - 1 - j])
         };
         for a in 0..p - 1 {
             let (sa, la) = col(a);
-            h[a] = sa[t0 - 1 - la..n - 1 - la]
-                .iter()
-                .zip(&y[t0..])
-                .map(|(x, z)| x * z)
-                .sum();
+            h[a] = dot(&sa[t0 - 1 - la..n - 1 - la], &y[t0..]);
             g[a * p + p - 1] = sa[t0 - 1 - la..n - 1 - la].iter().sum();
             for b in a..p - 1 {
                 let (sb, lb) = col(b);

@@ -380,7 +380,15 @@ fn quantify_inner(
     // pilot: the process family and a first structure, chosen at a spread of stiction parameters
     // (a staged search runs them again on the whole record: the first samples may be too few
     // to tell the structure)
-    let pilots = pilot_points(req.model, &bounds);
+    let pilots: Vec<Vec<f64>> = if hint.is_some() {
+        // the whole record's pilots: a quarter of the spread is enough to add its structures
+        pilot_points(req.model, &bounds)
+            .into_iter()
+            .step_by(4)
+            .collect()
+    } else {
+        pilot_points(req.model, &bounds)
+    };
     let choices: Vec<identify::Selection> = pilots
         .par_iter()
         .filter_map(|theta| {

@@ -706,7 +706,8 @@ fn distance_to_ellipse(a: f64, b: f64, p0: f64, p1: f64) -> f64 {
             let mut t = lo;
             for _ in 0..200 {
                 t = 0.5 * (lo + hi);
-                if t == lo || t == hi {
+                // a residual to a part in 1e10 is plenty for a goodness of fit
+                if t == lo || t == hi || hi - lo <= 1e-10 * (1.0 + t.abs()) {
                     break;
                 }
                 let (q0, q1) = (n0 / (t + r0), z1 / (t + 1.0));
