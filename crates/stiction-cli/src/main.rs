@@ -2,6 +2,7 @@
 //! flags are parsed here, turned into validated core requests, and results printed by a human or a
 //! JSON printer.
 
+mod cmd_batch;
 mod cmd_diagnose;
 mod cmd_estimate;
 mod cmd_quantify;
@@ -39,6 +40,7 @@ enum Command {
     Quantify(cmd_quantify::Args),
     /// Diagnose a loop from routine data: quality gates, oscillation, stiction indices and a verdict.
     Diagnose(cmd_diagnose::Args),
+    Batch(cmd_batch::Args),
     /// Reproduce published results (`stiction reproduce paper`).
     Reproduce(cmd_reproduce::Args),
 }
@@ -50,6 +52,7 @@ fn main() -> ExitCode {
         Command::Estimate(a) => cmd_estimate::run(a),
         Command::Quantify(a) => cmd_quantify::run(a),
         Command::Diagnose(a) => cmd_diagnose::run(a),
+        Command::Batch(a) => cmd_batch::run(a),
         Command::Reproduce(a) => cmd_reproduce::run(a),
     };
     match result {
