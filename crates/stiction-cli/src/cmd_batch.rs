@@ -368,11 +368,12 @@ fn process(job: Job, ctx: &Ctx) -> Row {
             )
         }
     };
-    let written = serde_json::to_value(&d)
+    // the row is read back from the JSON as written, exactly as `--resume` reads it
+    let written = serde_json::to_vec_pretty(&d)
         .map_err(anyhow::Error::from)
-        .and_then(|v| {
-            write_atomic(&json_path, &serde_json::to_vec_pretty(&v)?)?;
-            Ok(v)
+        .and_then(|bytes| {
+            write_atomic(&json_path, &bytes)?;
+            Ok(serde_json::from_slice::<Value>(&bytes)?)
         });
     let value = match written {
         Ok(v) => v,

@@ -73,7 +73,7 @@ pub fn write_loop_report(path: &Path, loop_id: &str, lf: &LoopFile, d: &Diagnosi
     }
     let _ = writeln!(
         b,
-        "<p><small>{} samples at {} s; samples {} to {} analysed; {} of OP from {} to {}.</small></p>",
+        "<p><small>{} samples at {} s; samples {} to {} analysed; {}; OP from {} to {}.</small></p>",
         d.samples,
         d.ts,
         d.analysed[0],

@@ -191,6 +191,24 @@ pub const CSV_HEADER: [&str; 13] = [
     "error",
 ];
 
+#[derive(Serialize)]
+struct Counts {
+    stiction: usize,
+    undetermined: usize,
+    no_stiction: usize,
+    insufficient_data: usize,
+    failed: usize,
+}
+
+/// summary.json: `complete` is false in the copies written while the batch runs.
+#[derive(Serialize)]
+struct SummaryJson<'a> {
+    complete: bool,
+    loops: usize,
+    counts: Counts,
+    rows: &'a [Row],
+}
+
 /// Write summary.csv and summary.json (rows ranked, each file atomically). `complete` is false
 /// for the interim copies written while the batch runs.
 pub fn write(outdir: &Path, rows: &mut [Row], complete: bool) -> Result<()> {
@@ -217,12 +235,18 @@ pub fn write(outdir: &Path, rows: &mut [Row], complete: bool) -> Result<()> {
     let csv = w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
     write_atomic(&outdir.join("summary.csv"), &csv)?;
     let c = counts(rows);
-    let json = serde_json::json!({
-        "complete": complete,
-        "loops": rows.len(),
-        "counts": VERDICTS.iter().zip(c).map(|(v, n)| (v.to_string(), Value::from(n))).collect::<serde_json::Map<_, _>>(),
-        "rows": rows,
-    });
+    let json = SummaryJson {
+        complete,
+        loops: rows.len(),
+        counts: Counts {
+            stiction: c[0],
+            undetermined: c[1],
+            no_stiction: c[2],
+            insufficient_data: c[3],
+            failed: c[4],
+        },
+        rows,
+    };
     write_atomic(
         &outdir.join("summary.json"),
         &serde_json::to_vec_pretty(&json)?,
