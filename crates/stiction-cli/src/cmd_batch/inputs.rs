@@ -241,8 +241,8 @@ pub fn file_key(raw: &str) -> String {
 #[derive(Default)]
 pub struct Ids {
     used: HashSet<String>,
-    /// Sources of the first loop of each id, to name both in the note.
-    first: HashMap<String, String>,
+    /// The first loop of each id (lower case): its id and source, to name both in the note.
+    first: HashMap<String, (String, String)>,
     pub notes: Vec<String>,
     pub duplicates: usize,
 }
@@ -251,7 +251,8 @@ impl Ids {
     pub fn assign(&mut self, raw: &str, source: &str) -> String {
         let key = file_key(raw);
         if self.used.insert(key.to_lowercase()) {
-            self.first.insert(key.to_lowercase(), source.to_string());
+            self.first
+                .insert(key.to_lowercase(), (key.clone(), source.to_string()));
             return key;
         }
         let mut n = 2;
@@ -264,14 +265,16 @@ impl Ids {
         };
         self.duplicates += 1;
         if self.notes.len() < 5 {
-            let first = self
+            let (first_id, first_source) = self
                 .first
                 .get(&key.to_lowercase())
                 .cloned()
                 .unwrap_or_default();
-            self.notes.push(format!(
-                "loop id '{key}' is used by {first} and by {source}; the second is named '{id}'"
-            ));
+            self.notes.push(if first_id == key {
+                format!("loop id '{key}' is used by {first_source} and by {source}; the second is named '{id}'")
+            } else {
+                format!("loop ids '{first_id}' ({first_source}) and '{key}' ({source}) differ only in case; the second is named '{id}'")
+            });
         }
         id
     }
