@@ -299,13 +299,16 @@ fn remap_lines(msg: &str, lines: &[u64]) -> String {
 /// Read one loop. A long-format loop goes through a temporary file so that `data::Table` and
 /// `Columns::read` (shared with `diagnose`) read it exactly as they read a file of its own;
 /// their messages are then pointed back at the long file and its lines.
-fn read_loop(id: &str, data: JobData, ctx: &Ctx) -> Result<LoopFile, String> {
+fn read_loop(data: JobData, ctx: &Ctx) -> Result<LoopFile, String> {
     match data {
         JobData::File(path) => data::Table::read(&path)
             .and_then(|t| ctx.columns.read(&t))
             .map_err(|e| format!("{e:#}")),
         JobData::Rows { file, csv, lines } => {
-            let tmp = ctx.tmp_dir.join(format!("{id}.csv"));
+            // one temporary file per worker thread, rewritten for each loop: creating and
+            // deleting a file per loop costs more than reading it
+            let slot = rayon::current_thread_index().unwrap_or(0);
+            let tmp = ctx.tmp_dir.join(format!("worker{slot}.csv"));
             std::fs::write(&tmp, &csv).map_err(|e| {
                 format!(
                     "{}: cannot write a temporary file: {e}; check the free space of the output folder",
@@ -314,7 +317,6 @@ fn read_loop(id: &str, data: JobData, ctx: &Ctx) -> Result<LoopFile, String> {
             })?;
             drop(csv);
             let read = data::Table::read(&tmp).and_then(|t| ctx.columns.read(&t));
-            let _ = std::fs::remove_file(&tmp);
             read.map_err(|e| {
                 let msg = format!("{e:#}")
                     .replace(&tmp.display().to_string(), &file.display().to_string());
@@ -348,7 +350,7 @@ fn process(job: Job, ctx: &Ctx) -> Row {
             };
         }
     }
-    let lf = match read_loop(&id, data, ctx) {
+    let lf = match read_loop(data, ctx) {
         Ok(lf) => lf,
         Err(why) => return Row::failed(&id, &source, why),
     };

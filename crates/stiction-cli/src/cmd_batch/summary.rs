@@ -3,11 +3,12 @@
 //! A row is always built from the diagnosis as JSON (the same text that goes to `loops/<id>.json`),
 //! so a row rebuilt by `--resume` from that file equals the row of a fresh run.
 
-use crate::cmd_simulate::write_atomic;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use serde::Serialize;
 use serde_json::Value;
 use std::cmp::Ordering;
+use std::fs::File;
+use std::io::{BufWriter, Write};
 use std::path::Path;
 
 /// The verdicts in ranking order, `failed` last.
@@ -209,31 +210,50 @@ struct SummaryJson<'a> {
     rows: &'a [Row],
 }
 
-/// Write summary.csv and summary.json (rows ranked, each file atomically). `complete` is false
-/// for the interim copies written while the batch runs.
+/// Write a file atomically (a temporary file beside it, then a rename), streaming the content.
+fn write_streamed(path: &Path, body: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
+    let tmp = path.with_extension(format!(
+        "{}.tmp{}",
+        path.extension().and_then(|e| e.to_str()).unwrap_or(""),
+        std::process::id()
+    ));
+    let cannot = || format!("{}: cannot write the file", path.display());
+    let mut w = BufWriter::new(File::create(&tmp).with_context(cannot)?);
+    body(&mut w).with_context(cannot)?;
+    w.into_inner()
+        .map_err(|e| e.into_error())
+        .with_context(cannot)?;
+    std::fs::rename(&tmp, path).with_context(cannot)
+}
+
+/// Write summary.csv and summary.json (rows ranked, each file atomically and streamed, so that
+/// no copy of the summary is built in memory). `complete` is false for the interim copies
+/// written while the batch runs.
 pub fn write(outdir: &Path, rows: &mut [Row], complete: bool) -> Result<()> {
     rows.sort_by(ranking);
-    let mut w = csv::Writer::from_writer(Vec::with_capacity(rows.len() * 256 + 256));
-    w.write_record(CSV_HEADER)?;
-    for r in rows.iter() {
-        w.write_record([
-            r.loop_id.as_str(),
-            &r.source,
-            &r.verdict,
-            &cell(r.confidence),
-            &cell(Some(r.severity)),
-            &cell(r.apparent_stiction_closed_loop),
-            &cell(r.apparent_stiction_ellipse),
-            &cell(r.period_s),
-            &cell(r.regularity),
-            &r.reason,
-            &r.samples.map(|s| s.to_string()).unwrap_or_default(),
-            &cell(r.seconds),
-            &r.error,
-        ])?;
-    }
-    let csv = w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
-    write_atomic(&outdir.join("summary.csv"), &csv)?;
+    write_streamed(&outdir.join("summary.csv"), |out| {
+        let mut w = csv::Writer::from_writer(out);
+        w.write_record(CSV_HEADER)?;
+        for r in rows.iter() {
+            w.write_record([
+                r.loop_id.as_str(),
+                &r.source,
+                &r.verdict,
+                &cell(r.confidence),
+                &cell(Some(r.severity)),
+                &cell(r.apparent_stiction_closed_loop),
+                &cell(r.apparent_stiction_ellipse),
+                &cell(r.period_s),
+                &cell(r.regularity),
+                &r.reason,
+                &r.samples.map(|s| s.to_string()).unwrap_or_default(),
+                &cell(r.seconds),
+                &r.error,
+            ])?;
+        }
+        w.flush()?;
+        Ok(())
+    })?;
     let c = counts(rows);
     let json = SummaryJson {
         complete,
@@ -247,9 +267,9 @@ pub fn write(outdir: &Path, rows: &mut [Row], complete: bool) -> Result<()> {
         },
         rows,
     };
-    write_atomic(
-        &outdir.join("summary.json"),
-        &serde_json::to_vec_pretty(&json)?,
-    )?;
-    Ok(())
+    write_streamed(&outdir.join("summary.json"), |out| {
+        serde_json::to_writer_pretty(&mut *out, &json)?;
+        out.write_all(b"\n")?;
+        Ok(())
+    })
 }
