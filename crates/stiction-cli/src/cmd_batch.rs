@@ -43,7 +43,9 @@ use summary::{Row, VERDICTS};
 Writes OUTDIR/summary.csv and summary.json (one row per loop, ranked by severity = apparent
 stiction x confidence for a stiction verdict, then verdict, then loop id), OUTDIR/loops/<id>.json
 (the full diagnosis), and with --reports OUTDIR/reports/<id>.html and OUTDIR/index.html. A loop
-that cannot be read is a 'failed' row with the reason; the batch goes on."
+that cannot be read is a 'failed' row with the reason; the batch goes on.
+Loop ids: the file stem, or the loop id cell of a long-format file, as a safe file name; an id
+used twice gets a suffix in input order (X, X~2, X~3), with a note."
 )]
 pub struct Args {
     /// Folders (every *.csv directly inside), file patterns such as 'plant/*.csv' (quoted), CSV
@@ -111,7 +113,14 @@ pub fn run(a: Args) -> Result<()> {
         Some(n) => n,
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
-    let files = inputs::expand(&a.inputs)?;
+    let mut files = inputs::expand(&a.inputs)?;
+    // OUTDIR given as an input folder too: its own summary is not a loop
+    if let Ok(own) = std::fs::canonicalize(a.output.join("summary.csv")) {
+        files.retain(|f| std::fs::canonicalize(f).map_or(true, |c| c != own));
+        if files.is_empty() {
+            bail!("no loop files among the inputs (only the summary.csv of {}); give the folders or files holding the loops", a.output.display());
+        }
+    }
     let inputs = inputs::classify(files, &a.loop_id, &a.columns)?;
 
     let out = a.output.clone();
@@ -201,8 +210,19 @@ pub fn run(a: Args) -> Result<()> {
             .into_iter()
             .par_bridge()
             .for_each_with(row_tx, |tx, job| {
-                let weight = job.weight;
-                let _ = tx.send((process(job, &ctx), weight));
+                let (id, source, weight) = (job.id.clone(), job.source.clone(), job.weight);
+                // a bug in one loop's path is that loop's failure, never the batch's
+                let row = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    process(job, &ctx)
+                }))
+                .unwrap_or_else(|_| {
+                    Row::failed(
+                        &id,
+                        &source,
+                        format!("{source}: stopped on an internal error (a bug: please report it with this file)"),
+                    )
+                });
+                let _ = tx.send((row, weight));
             })
     });
     let ids = reader.join().expect("the reader thread does not panic");
@@ -356,19 +376,9 @@ fn process(job: Job, ctx: &Ctx) -> Row {
     };
     let mut req = ctx.columns.request(lf.ts);
     req.quantify = ctx.quantify;
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        diagnose(&lf.record(), &req)
-    }));
-    let d = match result {
-        Ok(Ok(d)) => d,
-        Ok(Err(e)) => return Row::failed(&id, &source, format!("{source}: {e}")),
-        Err(_) => {
-            return Row::failed(
-                &id,
-                &source,
-                format!("{source}: diagnose stopped on an internal error (a bug: please report it with this file)"),
-            )
-        }
+    let d = match diagnose(&lf.record(), &req) {
+        Ok(d) => d,
+        Err(e) => return Row::failed(&id, &source, format!("{source}: {e}")),
     };
     // the row is read back from the JSON as written, exactly as `--resume` reads it
     let written = serde_json::to_vec_pretty(&d)

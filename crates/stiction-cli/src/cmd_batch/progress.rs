@@ -22,7 +22,7 @@ impl Progress {
         let bar = std::io::stderr().is_terminal().then(|| {
             let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
             bar.set_style(
-                ProgressStyle::with_template("batch {bar:32.cyan/blue} {msg}")
+                ProgressStyle::with_template("{bar:24.cyan/blue} {msg}")
                     .unwrap_or_else(|_| ProgressStyle::default_bar())
                     .progress_chars("=> "),
             );
@@ -58,7 +58,7 @@ impl Progress {
         let f = self.fraction();
         let done = match self.total_loops {
             Some(n) => format!("{}/{n} loops", self.done),
-            None => format!("{} loops ({:.0} % of the input)", self.done, 100.0 * f),
+            None => format!("{} loops, {:.0} % of the input", self.done, 100.0 * f),
         };
         let eta = if f > 0.0 && f < 1.0 {
             format!(", ETA {:.0} s", secs * (1.0 - f) / f)
