@@ -21,7 +21,7 @@ use crate::cmd_diagnose::{Columns, LoopFile};
 use crate::cmd_simulate::write_atomic;
 use crate::data;
 use anyhow::{bail, Context, Result};
-use inputs::{Job, JobData};
+use inputs::{Ids, Job, JobData};
 use progress::Progress;
 use rayon::prelude::*;
 use serde_json::Value;
@@ -79,6 +79,7 @@ pub struct Args {
 struct Ctx {
     columns: Columns,
     quantify: bool,
+    out: PathBuf,
     loops_dir: PathBuf,
     reports_dir: Option<PathBuf>,
     tmp_dir: PathBuf,
@@ -118,19 +119,52 @@ pub fn run(a: Args) -> Result<()> {
     if let Ok(own) = std::fs::canonicalize(a.output.join("summary.csv")) {
         files.retain(|f| std::fs::canonicalize(f).map_or(true, |c| c != own));
         if files.is_empty() {
-            bail!("no loop files among the inputs (only the summary.csv of {}); give the folders or files holding the loops", a.output.display());
+            bail!(
+                "no loop files among the inputs (only the summary.csv of {}); give the folders or files holding the loops",
+                a.output.display()
+            );
         }
     }
     let inputs = inputs::classify(files, &a.loop_id, &a.columns)?;
+    let ctx = prepare_output(&a)?;
+    let (mut rows, ids) = diagnose_all(inputs, &ctx, threads)?;
+    let _ = std::fs::remove_dir_all(&ctx.tmp_dir);
+    let out = &a.output;
+    summary::write(out, &mut rows, true)
+        .with_context(|| format!("{}: cannot write the summary", out.display()))?;
+    if a.reports {
+        html::write_index(out, &rows, true)?;
+    }
+    for note in &ids.notes {
+        eprintln!("note: {note}");
+    }
+    if ids.duplicates > ids.notes.len() {
+        eprintln!(
+            "note: {} more loop ids were used twice and got a ~N suffix (see the source column)",
+            ids.duplicates - ids.notes.len()
+        );
+    }
+    print_outcome(
+        &rows,
+        out,
+        started.elapsed().as_secs_f64(),
+        threads,
+        a.reports,
+    );
+    Ok(())
+}
 
-    let out = a.output.clone();
-    let shown = out.display().to_string();
+/// Make OUTDIR ready: its folders, the settings of this run (checked against the earlier run's
+/// with `--resume`), an empty summary so a stale one never passes for this run's.
+fn prepare_output(a: &Args) -> Result<Ctx> {
+    let out = &a.output;
+    let shown = out.display();
     let loops_dir = out.join("loops");
     std::fs::create_dir_all(&loops_dir).with_context(|| {
         format!("{shown}: cannot create the output folder; choose a writable folder with -o OUTDIR")
     })?;
     let settings_path = out.join("batch.json");
-    let settings = settings(&a);
+    let settings = settings(a);
     if a.resume {
         if let Some(old) = std::fs::read(&settings_path)
             .ok()
@@ -146,8 +180,7 @@ pub fn run(a: Args) -> Result<()> {
     write_atomic(&settings_path, &serde_json::to_vec_pretty(&settings)?).with_context(|| {
         format!("{shown}: the output folder is not writable; choose another with -o OUTDIR")
     })?;
-    // an empty summary straight away: a stale one from an earlier run never passes for this one
-    summary::write(&out, &mut [], false)?;
+    summary::write(out, &mut [], false)?;
     let reports_dir = a.reports.then(|| out.join("reports"));
     if let Some(dir) = &reports_dir {
         std::fs::create_dir_all(dir)
@@ -157,47 +190,50 @@ pub fn run(a: Args) -> Result<()> {
     let _ = std::fs::remove_dir_all(&tmp_dir); // left by an interrupted run
     std::fs::create_dir_all(&tmp_dir)
         .with_context(|| format!("{}: cannot create the folder", tmp_dir.display()))?;
-
-    let ctx = Ctx {
+    Ok(Ctx {
         columns: a.columns.clone(),
         quantify: !a.no_quantify,
+        out: out.clone(),
         loops_dir,
         reports_dir,
-        tmp_dir: tmp_dir.clone(),
+        tmp_dir,
         resume: a.resume,
-    };
+    })
+}
+
+/// The pipeline: a reader thread streams jobs over a bounded channel into the pool; a collector
+/// thread keeps the rows, shows the progress and rewrites the summary every 2 s.
+fn diagnose_all(inputs: inputs::Inputs, ctx: &Ctx, threads: usize) -> Result<(Vec<Row>, Ids)> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .context("cannot start the worker threads")?;
-
-    // reader -> (bounded) -> workers -> rows -> collector
     let (job_tx, job_rx) = mpsc::sync_channel::<Job>(4 * threads + 8);
     let (row_tx, row_rx) = mpsc::channel::<(Row, u64)>();
     let mut progress = Progress::new(inputs.known_loops(), inputs.total_bytes);
     let reader = std::thread::spawn(move || inputs::stream(inputs.sources, job_tx));
-    let collector_out = out.clone();
-    let with_index = a.reports;
+    let out = ctx.out.clone();
+    let with_index = ctx.reports_dir.is_some();
     let collector = std::thread::spawn(move || {
         let mut rows: Vec<Row> = Vec::new();
         let mut last_write = Instant::now();
-        let mut write_error = None;
+        let mut warned = false;
         for (row, weight) in row_rx {
             rows.push(row);
             progress.tick(weight);
             if last_write.elapsed() >= Duration::from_secs(2) {
                 last_write = Instant::now();
-                let r = summary::write(&collector_out, &mut rows, false).and_then(|()| {
+                let written = summary::write(&out, &mut rows, false).and_then(|()| {
                     if with_index {
-                        html::write_index(&collector_out, &rows, false)
+                        html::write_index(&out, &rows, false)
                     } else {
                         Ok(())
                     }
                 });
-                if let Err(e) = r {
-                    if write_error.is_none() {
+                if let Err(e) = written {
+                    if !warned {
                         progress.println(&format!("warning: the interim summary: {e:#}"));
-                        write_error = Some(e);
+                        warned = true;
                     }
                 }
             }
@@ -213,7 +249,7 @@ pub fn run(a: Args) -> Result<()> {
                 let (id, source, weight) = (job.id.clone(), job.source.clone(), job.weight);
                 // a bug in one loop's path is that loop's failure, never the batch's
                 let row = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    process(job, &ctx)
+                    process(job, ctx)
                 }))
                 .unwrap_or_else(|_| {
                     Row::failed(
@@ -226,34 +262,20 @@ pub fn run(a: Args) -> Result<()> {
             })
     });
     let ids = reader.join().expect("the reader thread does not panic");
-    let mut rows = collector
+    let rows = collector
         .join()
         .expect("the collector thread does not panic");
-    let _ = std::fs::remove_dir_all(&tmp_dir);
-    summary::write(&out, &mut rows, true)
-        .with_context(|| format!("{shown}: cannot write the summary"))?;
-    if a.reports {
-        html::write_index(&out, &rows, true)?;
-    }
+    Ok((rows, ids))
+}
 
-    for note in &ids.notes {
-        eprintln!("note: {note}");
-    }
-    if ids.duplicates > ids.notes.len() {
-        eprintln!(
-            "note: {} more loop ids were used twice and got a ~N suffix (see the source column)",
-            ids.duplicates - ids.notes.len()
-        );
-    }
-    let secs = started.elapsed().as_secs_f64();
-    let counts = summary::counts(&rows);
+fn print_outcome(rows: &[Row], out: &Path, secs: f64, threads: usize, reports: bool) {
+    let counts = summary::counts(rows);
     let parts: Vec<String> = VERDICTS
         .iter()
         .zip(counts)
         .filter(|(_, n)| *n > 0)
         .map(|(v, n)| format!("{n} {v}"))
         .collect();
-    let resumed = rows.iter().filter(|r| r.resumed).count();
     println!(
         "batch: {} loops in {secs:.1} s ({:.0} loops/s, {threads} threads): {}",
         rows.len(),
@@ -264,6 +286,7 @@ pub fn run(a: Args) -> Result<()> {
             parts.join(", ")
         }
     );
+    let resumed = rows.iter().filter(|r| r.resumed).count();
     if resumed > 0 {
         println!("  {resumed} of them kept from an earlier run (--resume)");
     }
@@ -283,13 +306,12 @@ pub fn run(a: Args) -> Result<()> {
         out.join("summary.csv").display(),
         out.join("summary.json").display(),
         out.join("loops").display(),
-        if a.reports {
+        if reports {
             format!(", {}", out.join("index.html").display())
         } else {
             String::new()
         }
     );
-    Ok(())
 }
 
 /// "line N" in a message about the temporary file of a loop of a long-format file becomes the
