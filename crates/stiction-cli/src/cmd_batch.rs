@@ -206,41 +206,48 @@ fn prepare_output(a: &Args) -> Result<Ctx> {
 fn diagnose_all(inputs: inputs::Inputs, ctx: &Ctx, threads: usize) -> Result<(Vec<Row>, Ids)> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
+        .thread_name(|i| format!("batch-worker{i}"))
         .build()
         .context("cannot start the worker threads")?;
     let (job_tx, job_rx) = mpsc::sync_channel::<Job>(4 * threads + 8);
     let (row_tx, row_rx) = mpsc::channel::<(Row, u64)>();
     let mut progress = Progress::new(inputs.known_loops(), inputs.total_bytes);
-    let reader = std::thread::spawn(move || inputs::stream(inputs.sources, job_tx));
+    let reader = std::thread::Builder::new()
+        .name("batch-reader".into())
+        .spawn(move || inputs::stream(inputs.sources, job_tx))
+        .context("cannot start the reader thread")?;
     let out = ctx.out.clone();
     let with_index = ctx.reports_dir.is_some();
-    let collector = std::thread::spawn(move || {
-        let mut rows: Vec<Row> = Vec::new();
-        let mut last_write = Instant::now();
-        let mut warned = false;
-        for (row, weight) in row_rx {
-            rows.push(row);
-            progress.tick(weight);
-            if last_write.elapsed() >= Duration::from_secs(2) {
-                last_write = Instant::now();
-                let written = summary::write(&out, &mut rows, false).and_then(|()| {
-                    if with_index {
-                        html::write_index(&out, &rows, false)
-                    } else {
-                        Ok(())
-                    }
-                });
-                if let Err(e) = written {
-                    if !warned {
-                        progress.println(&format!("warning: the interim summary: {e:#}"));
-                        warned = true;
+    let collector = std::thread::Builder::new()
+        .name("batch-collector".into())
+        .spawn(move || {
+            let mut rows: Vec<Row> = Vec::new();
+            let mut last_write = Instant::now();
+            let mut warned = false;
+            for (row, weight) in row_rx {
+                rows.push(row);
+                progress.tick(weight);
+                if last_write.elapsed() >= Duration::from_secs(2) {
+                    last_write = Instant::now();
+                    let written = summary::write(&out, &mut rows, false).and_then(|()| {
+                        if with_index {
+                            html::write_index(&out, &rows, false)
+                        } else {
+                            Ok(())
+                        }
+                    });
+                    if let Err(e) = written {
+                        if !warned {
+                            progress.println(&format!("warning: the interim summary: {e:#}"));
+                            warned = true;
+                        }
                     }
                 }
             }
-        }
-        progress.finish();
-        rows
-    });
+            progress.finish();
+            rows
+        })
+        .context("cannot start the collector thread")?;
     pool.install(|| {
         job_rx
             .into_iter()
