@@ -365,7 +365,10 @@ fn stream_long(long: &LongFile, ids: &mut Ids, tx: &SyncSender<Job>) -> bool {
     let emit = |group: Group, end_byte: u64, ids: &mut Ids| -> bool {
         let first = group.lines.first().copied().unwrap_or(0);
         let last = group.lines.last().copied().unwrap_or(0);
-        let source = format!("{shown} lines {first}-{last}");
+        let mut source = format!("{shown} lines {first}-{last}");
+        if file_key(&group.raw_id) != group.raw_id {
+            source.push_str(&format!(" ({id_name} '{}')", group.raw_id));
+        }
         let id = ids.assign(&group.raw_id, &source);
         let data = if group.raw_id.is_empty() {
             JobData::Fail(format!(

@@ -78,11 +78,15 @@ impl Progress {
             bar.set_message(self.message());
             return;
         }
+        // every 5 s, or at each tenth but at most once a second (a short batch stays quiet)
         let tenth = (f * 10.0) as u64;
-        if self.last_line.elapsed() >= Duration::from_secs(5) || tenth > self.last_tenth {
+        let since = self.last_line.elapsed();
+        if since >= Duration::from_secs(5)
+            || (tenth > self.last_tenth && since >= Duration::from_secs(1))
+        {
             self.last_line = Instant::now();
             self.last_tenth = tenth;
-            if f < 1.0 {
+            if f < 0.995 {
                 eprintln!("batch: {}", self.message());
             }
         }
