@@ -53,7 +53,7 @@ pub fn run(a: Args) -> Result<()> {
 
 /// Write the report of one loop to `path` (atomically: a temporary file, then a rename).
 /// `loop_id` names the loop in the title (a file name or tag; escaped here).
-#[allow(dead_code)] // the entry point for the batch command
+#[allow(dead_code)] // a library-style entry point; `report` itself passes the columns
 pub fn write_report(path: &Path, loop_id: &str, lf: &LoopFile, d: &Diagnosis) -> Result<()> {
     write_report_with(path, loop_id, lf, d, None)
 }
@@ -71,8 +71,7 @@ pub fn write_report_with(
     cmd_simulate::write_atomic(path, html.as_bytes())
 }
 
-/// The report as one HTML document.
-#[allow(dead_code)] // for the batch command
+/// The report as one HTML document (the batch command adds a link back to its index).
 pub fn render(loop_id: &str, lf: &LoopFile, d: &Diagnosis) -> Result<String> {
     render_with(loop_id, lf, d, None)
 }

@@ -2,6 +2,7 @@
 //! flags are parsed here, turned into validated core requests, and results printed by a human or a
 //! JSON printer.
 
+mod cmd_batch;
 mod cmd_diagnose;
 mod cmd_estimate;
 mod cmd_quantify;
@@ -42,6 +43,8 @@ enum Command {
     Diagnose(cmd_diagnose::Args),
     /// Diagnose a loop and write one self-contained HTML report (inline SVG charts, no network).
     Report(cmd_report::Args),
+    /// Diagnose and quantify many loops in parallel: a ranked summary, per-loop JSON and reports.
+    Batch(cmd_batch::Args),
     /// Reproduce published results (`stiction reproduce paper`).
     Reproduce(cmd_reproduce::Args),
 }
@@ -59,6 +62,7 @@ fn main() -> ExitCode {
         Command::Quantify(a) => cmd_quantify::run(a),
         Command::Diagnose(a) => cmd_diagnose::run(a),
         Command::Report(a) => cmd_report::run(a),
+        Command::Batch(a) => cmd_batch::run(a),
         Command::Reproduce(a) => cmd_reproduce::run(a),
     };
     match result {

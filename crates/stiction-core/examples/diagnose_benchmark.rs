@@ -272,8 +272,11 @@ fn main() {
          deviations {noises:?}, seeds {seeds:?}, processes: {}.\n",
         processes.map(|p| p.0).join("; ")
     );
-    let _ = writeln!(md, "| family | process | noise | right | verdicts |");
-    let _ = writeln!(md, "|---|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "| family | process | noise | oscillating | right | verdicts |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|");
     let mut conf = Confusion::default();
     let mut secs = 0.0;
     for family in families {
@@ -281,6 +284,7 @@ fn main() {
             for noise in noises {
                 let mut verdicts = Vec::new();
                 let mut ok = 0;
+                let mut oscillating = 0;
                 for seed in seeds {
                     let d = [1.0, 2.0, 4.0][(seed as usize - 1) % 3];
                     let sticky = family == "sticky valve";
@@ -320,6 +324,9 @@ fn main() {
                     let dg = diagnose(&rec, &req).expect("valid request");
                     secs += t.elapsed().as_secs_f64();
                     conf.add(sticky, dg.verdict);
+                    if dg.oscillation.as_ref().is_some_and(|o| o.oscillating) {
+                        oscillating += 1;
+                    }
                     if right(sticky, dg.verdict) {
                         ok += 1;
                     }
@@ -333,9 +340,9 @@ fn main() {
                 }
                 let _ = writeln!(
                     md,
-                    "| {family} | {pname} | {noise} | {ok}/{} | {} |",
-                    seeds.len(),
-                    verdicts.join(", ")
+                    "| {family} | {pname} | {noise} | {oscillating}/{n} | {ok}/{n} | {} |",
+                    verdicts.join(", "),
+                    n = seeds.len()
                 );
             }
         }

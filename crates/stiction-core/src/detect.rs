@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 pub struct Regularity {
     /// Mean period, seconds (`None` with fewer than 3 zero crossings of the autocorrelation).
     pub period: Option<f64>,
-    /// r = mean(Tp) / (3 std(Tp)); infinite for perfectly regular periods.
+    /// r = mean(Tp) / (3 std(Tp)); `REGULARITY_CAP` for perfectly regular periods.
     pub regularity: f64,
     /// The threshold: r above it means a regular oscillation.
     pub threshold: f64,
@@ -25,6 +25,9 @@ pub struct Regularity {
 
 /// Default threshold on Thornhill's r.
 pub const REGULARITY_THRESHOLD: f64 = 1.0;
+
+/// The largest regularity reported (perfectly regular periods).
+pub const REGULARITY_CAP: f64 = 1e6;
 
 /// Zero crossings of the autocorrelation used for the periods (about five periods).
 pub const MAX_CROSSINGS: usize = 11;
@@ -61,10 +64,11 @@ pub fn regularity(error: &[f64], ts: f64) -> Regularity {
         let m = periods.iter().sum::<f64>() / periods.len() as f64;
         let sd =
             (periods.iter().map(|p| (p - m) * (p - m)).sum::<f64>() / periods.len() as f64).sqrt();
+        // capped: perfectly regular periods would give infinity, which JSON cannot carry
         let r = if sd > 0.0 {
-            m / (3.0 * sd)
+            (m / (3.0 * sd)).min(REGULARITY_CAP)
         } else {
-            f64::INFINITY
+            REGULARITY_CAP
         };
         (Some(m), r)
     };

@@ -366,8 +366,9 @@ fn oscillation(error: &[f64], ts: f64) -> Oscillation {
     // an oscillation that stands out of the noise, found by either detector: Thornhill's
     // regularity (a regular period) or Hägglund's IAE count (repeated large half periods, also
     // when the period wanders)
-    let oscillating =
-        (regularity.oscillating && iae.exceedances >= 4 || iae.oscillating) && amp > 3.0 * noise;
+    // (a regular period stands out of noise at a smaller amplitude than a count of large areas)
+    let oscillating = (regularity.oscillating && iae.exceedances >= 4 && amp > 1.5 * noise)
+        || (iae.oscillating && amp > 3.0 * noise);
     Oscillation {
         oscillating,
         period,

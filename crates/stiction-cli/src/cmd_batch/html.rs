@@ -1,0 +1,104 @@
+//! HTML for `--reports`: a page per loop and `index.html` ranking them. Self-contained (inline
+//! CSS, no scripts, nothing fetched from elsewhere).
+//!
+//! The per-loop page is a placeholder until `stiction report` lands: at merge time
+//! `write_loop_report` calls `crate::cmd_report::write_report` instead.
+
+use super::summary::{Row, VERDICTS};
+use crate::cmd_simulate::write_atomic;
+use anyhow::Result;
+use std::fmt::Write as _;
+use std::path::Path;
+
+const STYLE: &str = "body{font-family:system-ui,sans-serif;margin:2em;color:#222;max-width:72em}\
+table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:.3em .6em;text-align:left;vertical-align:top}\
+th{background:#f3f3f3}td.n{text-align:right;font-variant-numeric:tabular-nums}\
+.stiction{color:#b00020;font-weight:bold}.undetermined{color:#a66a00}.no_stiction{color:#1b5e20}\
+.insufficient_data{color:#555}.failed{color:#b00020}small{color:#666}";
+
+pub fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+fn num(v: Option<f64>, decimals: usize) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.decimals$}"),
+        Some(x) if x > 0.0 => "∞".into(),
+        _ => "–".into(),
+    }
+}
+
+fn page(title: &str, body: &str) -> String {
+    format!(
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head>\n<body>\n{body}</body></html>\n",
+        escape(title)
+    )
+}
+
+/// `index.html`: every loop, ranked as in summary.csv, linking its report.
+pub fn write_index(outdir: &Path, rows: &[Row], complete: bool) -> Result<()> {
+    let mut b = String::new();
+    let _ = writeln!(b, "<h1>Stiction batch: {} loops</h1>", rows.len());
+    let counts = super::summary::counts(rows);
+    let parts: Vec<String> = VERDICTS
+        .iter()
+        .zip(counts)
+        .filter(|(_, n)| *n > 0)
+        .map(|(v, n)| format!("<span class=\"{v}\">{n} {}</span>", v.replace('_', " ")))
+        .collect();
+    let _ = writeln!(
+        b,
+        "<p>{}{}. Ranked by severity (apparent stiction &times; confidence), then verdict, then loop id. \
+         Data: <a href=\"summary.csv\">summary.csv</a>, <a href=\"summary.json\">summary.json</a>.</p>",
+        parts.join(", "),
+        if complete {
+            ""
+        } else {
+            " (the batch is still running or was interrupted: not every loop is listed)"
+        }
+    );
+    let _ = writeln!(
+        b,
+        "<table><tr><th>#</th><th>loop</th><th>verdict</th><th>confidence</th><th>severity</th><th>apparent stiction</th><th>period (s)</th><th>reason</th></tr>"
+    );
+    for (k, r) in rows.iter().enumerate() {
+        let name = if r.report {
+            format!(
+                "<a href=\"reports/{}.html\">{}</a>",
+                escape(&r.loop_id),
+                escape(&r.loop_id)
+            )
+        } else {
+            escape(&r.loop_id)
+        };
+        let _ = writeln!(
+            b,
+            "<tr><td class=\"n\">{}</td><td>{name}<br><small>{}</small></td><td class=\"{}\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td></tr>",
+            k + 1,
+            escape(&r.source),
+            escape(&r.verdict),
+            escape(&r.verdict.replace('_', " ")),
+            num(r.confidence, 2),
+            num(Some(r.severity), 3),
+            num(r.apparent_stiction_closed_loop.or(r.apparent_stiction_ellipse), 3),
+            num(r.period_s, 1),
+            escape(&r.reason)
+        );
+    }
+    let _ = writeln!(b, "</table>");
+    write_atomic(
+        &outdir.join("index.html"),
+        page("Stiction batch", &b).as_bytes(),
+    )
+}
