@@ -70,7 +70,7 @@ pub struct Args {
     /// Keep the loops whose OUTDIR/loops/<id>.json exists (an interrupted run) instead of diagnosing them again
     #[arg(long)]
     pub resume: bool,
-    /// Skip the closed-loop estimate of the band (much faster; severity is then 0 and the ranking is by verdict)
+    /// Skip the closed-loop estimate of the band (faster; severity then uses the ellipse estimate)
     #[arg(long)]
     pub no_quantify: bool,
 }

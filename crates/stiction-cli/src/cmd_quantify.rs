@@ -166,8 +166,10 @@ fn print_human(file: &str, q: &Quantification, plot_dir: Option<&Path>) {
         if let Some([lo, hi]) = q.interval.get(spec.name) {
             let what = match q.interval_kind.as_str() {
                 "exact" => "every value in",
-                "exact_local" => "every value in (exact near the best scan points)",
-                "exact_staged" => "every value in (exact over the best cells of the first samples)",
+                "exact_local" => "every value (exact near the best scan points) in",
+                "exact_staged" => {
+                    "every value (exact over the cells kept from a search of the first samples) in"
+                }
                 "grid" => "grid points at the minimum span",
                 _ => "fits equally well with the others fixed over",
             };
