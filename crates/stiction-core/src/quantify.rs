@@ -288,11 +288,18 @@ pub fn quantify(
     {
         // stage 1: the whole d-range on the first samples (same valve start, so every
         // whole-record cell lies inside one of its cells)
-        let m = STAGE_SAMPLES;
+        // at least a few oscillation periods: too short a start ranks the cells by the transient
+        let period = crate::detect::regularity(pv, 1.0).period.unwrap_or(0.0);
+        let m = STAGE_SAMPLES.max((STAGE_PERIODS * period) as usize);
         let mut first = req.clone();
         first.staged = false;
         first.full_partition = true;
-        if let Ok((q, hint)) = quantify_inner(&op[..m], &pv[..m], &first, None) {
+        let stage = if 2 * m <= n {
+            quantify_inner(&op[..m], &pv[..m], &first, None).ok()
+        } else {
+            None // too few periods to gain from a start: every cell
+        };
+        if let Some((q, hint)) = stage {
             if q.status == "ok" && !hint.ranges.is_empty() {
                 let (mut full, _) = quantify_inner(op, pv, req, Some(&hint))?;
                 full.evaluations += q.evaluations;
@@ -788,7 +795,9 @@ fn pilot_points(kind: ModelKind, bounds: &[(f64, f64)]) -> Vec<Vec<f64>> {
 const TOP_CELLS: usize = 24;
 /// A staged search starts on this many samples ...
 const STAGE_SAMPLES: usize = 600;
-/// ... when the record has at least this many.
+/// ... or this many oscillation periods of the PV, if more ...
+const STAGE_PERIODS: f64 = 8.0;
+/// ... when the record has at least this many samples, and twice the start.
 const STAGE_FROM: usize = 1500;
 
 /// A cell of the d-partition with its cost under each structure.

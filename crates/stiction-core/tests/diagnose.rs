@@ -154,3 +154,26 @@ fn windows_cover_the_record_and_bad_requests_are_errors() {
     r.pv = short;
     assert!(diagnose(&r, &quick()).is_err());
 }
+
+#[test]
+fn integrating_loops_use_the_second_difference_histogram() {
+    let sticky = run(2.0, |cl| {
+        cl.process = Process::Integrating {
+            k: 0.05,
+            delay: 5.0,
+        };
+        cl.pi.kc = 2.0;
+        cl.pi.ti = 100.0;
+        cl.samples = 3000;
+        cl.seed = 2;
+    });
+    let req = DiagnoseRequest {
+        integrating: true,
+        ..quick()
+    };
+    let d = diagnose(&record(&sticky), &req).unwrap();
+    assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
+    let ddpv = d.indices.iter().find(|i| i.name == "ddpv_histogram").unwrap();
+    assert_eq!(ddpv.vote, Vote::Stiction);
+    assert!(d.indices.iter().all(|i| i.name != "cross_correlation"));
+}
