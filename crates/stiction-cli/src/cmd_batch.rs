@@ -82,12 +82,9 @@ struct Ctx {
     out: PathBuf,
     loops_dir: PathBuf,
     reports_dir: Option<PathBuf>,
-    tmp_dir: PathBuf,
     resume: bool,
 }
 
-/// The report of one loop. The placeholder page until `stiction report` is merged; then this
-/// calls `crate::cmd_report::write_report(path, loop_id, lf, d)`.
 /// The loop's full report (`stiction report`), with a link back to the fleet's index page.
 fn write_loop_report(path: &Path, loop_id: &str, lf: &LoopFile, d: &Diagnosis) -> Result<()> {
     let html = crate::cmd_report::render(loop_id, lf, d)?.replacen(
@@ -134,7 +131,6 @@ pub fn run(a: Args) -> Result<()> {
     let inputs = inputs::classify(files, &a.loop_id, &a.columns)?;
     let ctx = prepare_output(&a)?;
     let (mut rows, ids) = diagnose_all(inputs, &ctx, threads)?;
-    let _ = std::fs::remove_dir_all(&ctx.tmp_dir);
     let out = &a.output;
     summary::write(out, &mut rows, true)
         .with_context(|| format!("{}: cannot write the summary", out.display()))?;
@@ -192,17 +188,14 @@ fn prepare_output(a: &Args) -> Result<Ctx> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
     }
-    let tmp_dir = out.join(".batch-tmp");
-    let _ = std::fs::remove_dir_all(&tmp_dir); // left by an interrupted run
-    std::fs::create_dir_all(&tmp_dir)
-        .with_context(|| format!("{}: cannot create the folder", tmp_dir.display()))?;
+    // left by an interrupted run of an earlier version
+    let _ = std::fs::remove_dir_all(out.join(".batch-tmp"));
     Ok(Ctx {
         columns: a.columns.clone(),
         quantify: !a.no_quantify,
         out: out.clone(),
         loops_dir,
         reports_dir,
-        tmp_dir,
         resume: a.resume,
     })
 }
@@ -327,8 +320,8 @@ fn print_outcome(rows: &[Row], out: &Path, secs: f64, threads: usize, reports: b
     );
 }
 
-/// "line N" in a message about the temporary file of a loop of a long-format file becomes the
-/// line of the long file (the temporary file has the header on line 1, row k on line k + 2).
+/// "line N" in a message about a loop of a long-format file (read as a small CSV: header on line
+/// 1, row k on line k + 2) becomes the line of the long file.
 fn remap_lines(msg: &str, lines: &[u64]) -> String {
     let mut out = String::with_capacity(msg.len());
     let mut rest = msg;
@@ -351,33 +344,17 @@ fn remap_lines(msg: &str, lines: &[u64]) -> String {
     out
 }
 
-/// Read one loop. A long-format loop goes through a temporary file so that `data::Table` and
-/// `Columns::read` (shared with `diagnose`) read it exactly as they read a file of its own;
-/// their messages are then pointed back at the long file and its lines.
+/// Read one loop. A long-format loop's rows are read from memory by `data::Table` and
+/// `Columns::read` (shared with `diagnose`) exactly as a file of its own; their messages are
+/// then pointed at the long file's lines.
 fn read_loop(data: JobData, ctx: &Ctx) -> Result<LoopFile, String> {
     match data {
         JobData::File(path) => data::Table::read(&path)
             .and_then(|t| ctx.columns.read(&t))
             .map_err(|e| format!("{e:#}")),
-        JobData::Rows { file, csv, lines } => {
-            // one temporary file per worker thread, rewritten for each loop: creating and
-            // deleting a file per loop costs more than reading it
-            let slot = rayon::current_thread_index().unwrap_or(0);
-            let tmp = ctx.tmp_dir.join(format!("worker{slot}.csv"));
-            std::fs::write(&tmp, &csv).map_err(|e| {
-                format!(
-                    "{}: cannot write a temporary file: {e}; check the free space of the output folder",
-                    tmp.display()
-                )
-            })?;
-            drop(csv);
-            let read = data::Table::read(&tmp).and_then(|t| ctx.columns.read(&t));
-            read.map_err(|e| {
-                let msg = format!("{e:#}")
-                    .replace(&tmp.display().to_string(), &file.display().to_string());
-                remap_lines(&msg, &lines)
-            })
-        }
+        JobData::Rows { file, csv, lines } => data::Table::parse(&file, &csv)
+            .and_then(|t| ctx.columns.read(&t))
+            .map_err(|e| remap_lines(&format!("{e:#}"), &lines)),
         JobData::Fail(why) => Err(why),
     }
 }
@@ -447,7 +424,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn lines_of_the_temporary_file_map_to_the_long_file() {
+    fn lines_of_a_loop_map_to_the_long_file() {
         let lines = [100, 101, 105];
         assert_eq!(
             remap_lines("x.csv: line 4, column 'op': 'a' is not a number", &lines),

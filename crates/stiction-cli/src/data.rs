@@ -16,13 +16,18 @@ pub struct Table {
 
 impl Table {
     pub fn read(path: &Path) -> Result<Table> {
-        let text = match std::fs::read(path) {
-            Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+        match std::fs::read(path) {
+            Ok(bytes) => Self::parse(path, &bytes),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 bail!("{}: no such file; check the path", path.display())
             }
             Err(e) => bail!("{}: cannot be read: {e}", path.display()),
-        };
+        }
+    }
+
+    /// A table from CSV text already in memory; `path` names it in messages.
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Table> {
+        let text = String::from_utf8_lossy(bytes);
         let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
         let first_line = text.lines().next().unwrap_or("");
         if first_line.trim().is_empty() {

@@ -173,7 +173,11 @@ fn integrating_loops_use_the_second_difference_histogram() {
     };
     let d = diagnose(&record(&sticky), &req).unwrap();
     assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
-    let ddpv = d.indices.iter().find(|i| i.name == "ddpv_histogram").unwrap();
+    let ddpv = d
+        .indices
+        .iter()
+        .find(|i| i.name == "ddpv_histogram")
+        .unwrap();
     assert_eq!(ddpv.vote, Vote::Stiction);
     assert!(d.indices.iter().all(|i| i.name != "cross_correlation"));
 }
