@@ -622,19 +622,36 @@ impl FullGram {
         let direct = |a: &[f64], i: usize, b: &[f64], j: usize| -> f64 {
             dot(&a[t0 - 1 - i..n - 1 - i], &b[t0 - 1 - j..n - 1 - j])
         };
+        // the constant column's products are sums of one column: differences of prefix sums
+        let prefix = |v: &[f64]| {
+            let mut out = vec![0.0; v.len() + 1];
+            for (i, x) in v.iter().enumerate() {
+                out[i + 1] = out[i] + x;
+            }
+            out
+        };
+        let (prefix_y, prefix_mv) = (prefix(y), prefix(mv));
         for a in 0..p - 1 {
             let (sa, la) = col(a);
             h[a] = dot(&sa[t0 - 1 - la..n - 1 - la], &y[t0..]);
-            g[a * p + p - 1] = sa[t0 - 1 - la..n - 1 - la].iter().sum();
+            let ps = if a < na { &prefix_y } else { &prefix_mv };
+            g[a * p + p - 1] = ps[n - 1 - la] - ps[t0 - 1 - la];
+        }
+        for a in 0..p - 1 {
+            let (sa, la) = col(a);
             for b in a..p - 1 {
                 let (sb, lb) = col(b);
                 // a lagged product shifts by one sample along a diagonal of one block: add the
                 // sample that enters, drop the one that leaves (exact up to rounding, O(1) each)
-                // (column a - 1 is column a one lag earlier unless a starts a block)
-                let shiftable = a != 0 && a != na && b != 0 && b != na;
-                g[a * p + b] = if shiftable {
+                // (column a - 1 is column a one lag earlier unless a starts a block); the first
+                // row (y one sample back against column b) is the output's product with column
+                // b one lag earlier, shifted the same way
+                let shiftable = b != 0 && b != na;
+                g[a * p + b] = if shiftable && a != 0 && a != na {
                     g[(a - 1) * p + (b - 1)] + sa[t0 - 1 - la] * sb[t0 - 1 - lb]
                         - sa[n - 1 - la] * sb[n - 1 - lb]
+                } else if shiftable && a == 0 {
+                    h[b - 1] + y[t0 - 1] * sb[t0 - 1 - lb] - y[n - 1] * sb[n - 1 - lb]
                 } else {
                     direct(sa, la, sb, lb)
                 };
