@@ -290,15 +290,13 @@ pub fn quantify(
         // whole-record cell lies inside one of its cells)
         // at least a few oscillation periods: too short a start ranks the cells by the transient
         let period = crate::detect::regularity(pv, 1.0).period.unwrap_or(0.0);
-        let m = STAGE_SAMPLES.max((STAGE_PERIODS * period) as usize);
+        let m = STAGE_SAMPLES
+            .max((STAGE_PERIODS * period) as usize)
+            .min(n / 2);
         let mut first = req.clone();
         first.staged = false;
         first.full_partition = true;
-        let stage = if 2 * m <= n {
-            quantify_inner(&op[..m], &pv[..m], &first, None).ok()
-        } else {
-            None // too few periods to gain from a start: every cell
-        };
+        let stage = quantify_inner(&op[..m], &pv[..m], &first, None).ok();
         if let Some((q, hint)) = stage {
             if q.status == "ok" && !hint.ranges.is_empty() {
                 let (mut full, _) = quantify_inner(op, pv, req, Some(&hint))?;
@@ -795,9 +793,9 @@ fn pilot_points(kind: ModelKind, bounds: &[(f64, f64)]) -> Vec<Vec<f64>> {
 const TOP_CELLS: usize = 24;
 /// A staged search starts on this many samples ...
 const STAGE_SAMPLES: usize = 600;
-/// ... or this many oscillation periods of the PV, if more ...
+/// ... or this many oscillation periods of the PV, if more, up to half the record ...
 const STAGE_PERIODS: f64 = 8.0;
-/// ... when the record has at least this many samples, and twice the start.
+/// ... when the record has at least this many samples.
 const STAGE_FROM: usize = 1500;
 
 /// A cell of the d-partition with its cost under each structure.
