@@ -165,17 +165,9 @@ impl Default for DiagnoseRequest {
     }
 }
 
-/// The signals of one loop record.
-#[derive(Debug, Clone, Copy)]
-pub struct LoopRecord<'a> {
-    pub op: &'a [f64],
-    pub pv: &'a [f64],
-    pub sp: Option<&'a [f64]>,
-    /// Seconds, one per sample.
-    pub time: Option<&'a [f64]>,
-    /// `true` where the controller is in automatic.
-    pub auto: Option<&'a [bool]>,
-}
+/// The signals of one loop record (op, pv, and when recorded sp, time in seconds, and `auto`:
+/// `true` where the controller is in automatic).
+pub use crate::quality::Record as LoopRecord;
 
 /// The diagnosis of one loop: shared by every front end (CLI, report, batch).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -624,16 +616,7 @@ struct Stretch {
 
 fn judge(r: &LoopRecord, whole: usize, (s, e): (usize, usize), req: &DiagnoseRequest) -> Stretch {
     let n = e - s;
-    let mut quality = quality::check(
-        &Record {
-            op: &r.op[s..e],
-            pv: &r.pv[s..e],
-            sp: r.sp.map(|v| &v[s..e]),
-            time: r.time.map(|v| &v[s..e]),
-            auto: r.auto.map(|v| &v[s..e]),
-        },
-        &req.limits,
-    );
+    let mut quality = quality::check(&r.slice(s, e), &req.limits);
     let excluded = whole - n;
     if excluded > 0 && (r.auto.is_some() || r.sp.is_some()) {
         quality.push(Finding {
@@ -852,13 +835,7 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
             if n - end < w / 2 {
                 end = n;
             }
-            let sub = LoopRecord {
-                op: &r.op[start..end],
-                pv: &r.pv[start..end],
-                sp: r.sp.map(|v| &v[start..end]),
-                time: r.time.map(|v| &v[start..end]),
-                auto: r.auto.map(|v| &v[start..end]),
-            };
+            let sub = r.slice(start, end);
             let (ws, we) = usable_stretch(&sub);
             let j = judge(&sub, end - start, (ws, we), req);
             let t = |k: usize| r.time.map_or(k as f64 * req.ts, |t| t[k]);

@@ -601,7 +601,9 @@ struct FullGram {
 }
 
 impl FullGram {
-    fn new(y: &[f64], mv: &[f64], na: usize, m: usize, t0: usize) -> Self {
+    /// `mv_row[j]`: the valve position's product with itself `j` samples back, which both
+    /// families share (`mv_products`).
+    fn new(y: &[f64], mv: &[f64], na: usize, m: usize, t0: usize, mv_row: &[f64]) -> Self {
         let p = na + m + 1;
         let n = y.len();
         let mut g = vec![0.0; p * p];
@@ -652,6 +654,8 @@ impl FullGram {
                         - sa[n - 1 - la] * sb[n - 1 - lb]
                 } else if shiftable && a == 0 {
                     h[b - 1] + y[t0 - 1] * sb[t0 - 1 - lb] - y[n - 1] * sb[n - 1 - lb]
+                } else if a == na {
+                    mv_row[lb]
                 } else {
                     direct(sa, la, sb, lb)
                 };
@@ -660,6 +664,17 @@ impl FullGram {
         g[(p - 1) * p + p - 1] = (n - t0) as f64;
         h[p - 1] = y[t0..].iter().sum();
         Self { g, h, yy, p, na, m }
+    }
+
+    /// Sum over t in `t0..n` of `mv[t - 1] mv[t - 1 - j]`, for `j` in `0..m`.
+    fn mv_products(mv: &[f64], m: usize, t0: usize) -> Vec<f64> {
+        let n = mv.len();
+        if n <= t0 {
+            return vec![0.0; m];
+        }
+        (0..m)
+            .map(|j| dot(&mv[t0 - 1..n - 1], &mv[t0 - 1 - j..n - 1 - j]))
+            .collect()
     }
 
     /// Least-squares parameters and one-step SSE of a structure, from the sub-matrix.
@@ -711,11 +726,12 @@ pub fn select(data: &Data, mv: &[f64], range: &SearchRange) -> Option<Selection>
     let na = range.na_max();
     let m = range.nk_max + range.nb_max - 1;
     let mut best: Option<(Structure, [f64; MAX_P], f64)> = None;
+    let mv_row = FullGram::mv_products(mv, m, data.t0);
     for integrating in [false, true] {
         if (integrating && !range.integrating) || (!integrating && !range.self_regulating) {
             continue;
         }
-        let gram = FullGram::new(data.y(integrating), mv, na, m, data.t0);
+        let gram = FullGram::new(data.y(integrating), mv, na, m, data.t0, &mv_row);
         for s in range
             .structures()
             .into_iter()

@@ -45,6 +45,7 @@ impl Default for Limits {
 }
 
 /// The signals a loop record may have.
+#[derive(Debug, Clone, Copy)]
 pub struct Record<'a> {
     pub op: &'a [f64],
     pub pv: &'a [f64],
@@ -53,6 +54,19 @@ pub struct Record<'a> {
     pub time: Option<&'a [f64]>,
     /// `true` where the controller is in automatic.
     pub auto: Option<&'a [bool]>,
+}
+
+impl<'a> Record<'a> {
+    /// Samples `[start, end)` of every signal.
+    pub fn slice(&self, start: usize, end: usize) -> Record<'a> {
+        Record {
+            op: &self.op[start..end],
+            pv: &self.pv[start..end],
+            sp: self.sp.map(|v| &v[start..end]),
+            time: self.time.map(|v| &v[start..end]),
+            auto: self.auto.map(|v| &v[start..end]),
+        }
+    }
 }
 
 fn finding(gate: &str, passed: bool, value: f64, limit: f64, message: String) -> Finding {
