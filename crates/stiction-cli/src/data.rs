@@ -8,8 +8,11 @@ use std::path::{Path, PathBuf};
 pub struct Table {
     pub path: PathBuf,
     pub headers: Vec<String>,
-    /// Data rows; each row as long as the header (missing trailing cells are empty).
-    rows: Vec<Vec<String>>,
+    /// Every cell's trimmed text, one after the other (one allocation for the whole file) ...
+    text: String,
+    /// ... and where each is: row after row, each row as long as the header (missing trailing
+    /// cells are empty).
+    spans: Vec<(usize, usize)>,
     /// File line number of each row (the header is line 1).
     lines: Vec<u64>,
 }
@@ -48,38 +51,48 @@ impl Table {
             .iter()
             .map(|h| h.trim().to_string())
             .collect();
-        let mut rows = Vec::new();
+        let mut cells = String::with_capacity(text.len());
+        let mut spans = Vec::new();
         let mut lines = Vec::new();
-        for record in reader.records() {
-            let record =
-                record.with_context(|| format!("{}: not a readable CSV file", path.display()))?;
+        let mut record = csv::StringRecord::new();
+        loop {
+            let more = reader
+                .read_record(&mut record)
+                .with_context(|| format!("{}: not a readable CSV file", path.display()))?;
+            if !more {
+                break;
+            }
             let line = record.position().map(|p| p.line()).unwrap_or(0);
             if record.iter().all(|c| c.trim().is_empty()) {
                 continue; // blank line
             }
-            let mut row: Vec<String> = record.iter().map(|c| c.trim().to_string()).collect();
-            if row.len() > headers.len() {
+            if record.len() > headers.len() {
                 bail!(
                     "{}: line {line} has {} cells but the header names {} columns; remove the extra cells or name the column",
                     path.display(),
-                    row.len(),
+                    record.len(),
                     headers.len()
                 );
             }
-            row.resize(headers.len(), String::new());
-            rows.push(row);
+            for c in record.iter() {
+                let start = cells.len();
+                cells.push_str(c.trim());
+                spans.push((start, cells.len()));
+            }
+            spans.resize(spans.len() + headers.len() - record.len(), (0, 0));
             lines.push(line);
         }
         Ok(Table {
             path: path.to_path_buf(),
             headers,
-            rows,
+            text: cells,
+            spans,
             lines,
         })
     }
 
     pub fn len(&self) -> usize {
-        self.rows.len()
+        self.lines.len()
     }
 
     /// Index of a column by name, case-insensitive.
@@ -100,22 +113,28 @@ impl Table {
         })
     }
 
+    /// The trimmed text of a cell.
+    fn cell(&self, row: usize, col: usize) -> &str {
+        let (a, b) = self.spans[row * self.headers.len() + col];
+        &self.text[a..b]
+    }
+
     /// Parse a column as finite numbers.
     pub fn numbers(&self, col: usize) -> Result<Vec<f64>> {
         let name = &self.headers[col];
         let file = self.path.display();
-        let mut out = Vec::with_capacity(self.rows.len());
-        for (i, row) in self.rows.iter().enumerate() {
-            let cell = &row[col];
+        let mut out = Vec::with_capacity(self.len());
+        for i in 0..self.len() {
+            let cell = self.cell(i, col);
             let line = self.lines[i];
             if cell.is_empty() {
-                let rest_empty = self.rows[i..].iter().all(|r| r[col].is_empty());
+                let rest_empty = (i..self.len()).all(|r| self.cell(r, col).is_empty());
                 if rest_empty {
                     bail!(
                         "{file}: column '{name}' ends at line {line} with {} values while the file has {} rows; \
                          columns of different lengths cannot be paired sample by sample: trim the file to the rows where every column has a value",
                         out.len(),
-                        self.rows.len()
+                        self.len()
                     );
                 }
                 bail!("{file}: line {line}, column '{name}' is empty; fill in the value or remove the row");
@@ -141,16 +160,16 @@ impl Table {
     pub fn modes(&self, col: usize) -> Result<Vec<bool>> {
         let name = &self.headers[col];
         let file = self.path.display();
-        let mut out = Vec::with_capacity(self.rows.len());
-        for (i, row) in self.rows.iter().enumerate() {
-            let cell = row[col].to_ascii_lowercase();
+        let mut out = Vec::with_capacity(self.len());
+        for i in 0..self.len() {
+            let cell = self.cell(i, col).to_ascii_lowercase();
             let auto = match cell.as_str() {
                 "auto" | "automatic" | "aut" | "a" | "1" | "true" | "on" | "cascade" | "cas" => true,
                 "manual" | "man" | "m" | "0" | "false" | "off" => false,
                 _ => bail!(
                     "{file}: line {}, column '{name}': '{}' is not a controller mode; use auto or manual (also 1 or 0)",
                     self.lines[i],
-                    row[col]
+                    self.cell(i, col)
                 ),
             };
             out.push(auto);
@@ -163,9 +182,9 @@ impl Table {
     pub fn times(&self, col: usize) -> Result<Vec<f64>> {
         let name = &self.headers[col];
         let file = self.path.display();
-        let mut out = Vec::with_capacity(self.rows.len());
-        for (i, row) in self.rows.iter().enumerate() {
-            let cell = &row[col];
+        let mut out = Vec::with_capacity(self.len());
+        for i in 0..self.len() {
+            let cell = self.cell(i, col);
             let line = self.lines[i];
             let v = cell
                 .parse::<f64>()
