@@ -1,43 +1,9 @@
 //! `stiction diagnose` as a user types it: the binary is spawned, its output read.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn stiction(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_stiction"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = stiction(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn fails(args: &[&str], needles: &[&str]) {
-    let out = stiction(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "{args:?} should fail");
-    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
-    assert_eq!(
-        err.trim().lines().count(),
-        1,
-        "{args:?}: not one line: {err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: '{n}' missing from: {err}");
-    }
-}
-
-fn json(text: &str) -> serde_json::Value {
-    serde_json::from_str(text).expect("valid JSON")
-}
+mod common;
+use common::{fails, json, ok};
 
 /// A closed loop (default process K = 3, tau = 10 s, delay = 10 s, PI 0.2 / 10 s).
 fn simulate(dir: &Path, name: &str, d: &str, extra: &[&str]) -> String {

@@ -2,25 +2,11 @@
 //! data's text, and renders in a real browser (headless Chromium) on a laptop and a phone width.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn stiction(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_stiction"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = stiction(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
+mod common;
+use common::{ok, stiction};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
