@@ -11,11 +11,15 @@
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 use stiction_core::diagnose::{diagnose, DiagnoseRequest, Diagnosis, LoopRecord, Verdict, Vote};
 use stiction_core::models::{Model, Stenman};
 use stiction_core::sim::{ClosedLoop, Pi, Process, Signal};
+
+#[path = "common/isdb.rs"]
+mod isdb;
+use isdb::{column, read_csv};
 
 const LOOPS: [(&str, bool); 14] = [
     ("CHEM1", true),
@@ -33,29 +37,6 @@ const LOOPS: [(&str, bool); 14] = [
     ("PAP7", false),
     ("PAP9", false),
 ];
-
-fn read_csv(path: &Path) -> Option<(Vec<String>, Vec<Vec<String>>)> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let mut lines = text.lines();
-    let header: Vec<String> = lines
-        .next()?
-        .split(',')
-        .map(|s| s.trim().to_string())
-        .collect();
-    let rows = lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').map(|s| s.trim().to_string()).collect())
-        .collect();
-    Some((header, rows))
-}
-
-fn column(header: &[String], rows: &[Vec<String>], name: &str) -> Vec<f64> {
-    let i = header
-        .iter()
-        .position(|h| h.eq_ignore_ascii_case(name))
-        .expect("column");
-    rows.iter().map(|r| r[i].parse().expect("number")).collect()
-}
 
 fn vote_cell(d: &Diagnosis, name: &str) -> String {
     d.indices

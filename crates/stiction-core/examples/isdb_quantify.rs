@@ -8,40 +8,20 @@
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 use stiction_core::estimate::Method;
 use stiction_core::models::ModelKind;
 use stiction_core::quantify::{quantify, QuantifyRequest};
 
+#[path = "common/isdb.rs"]
+mod isdb;
+use isdb::{column, read_csv};
+
 const LOOPS: [&str; 14] = [
     "CHEM1", "CHEM2", "CHEM10", "CHEM11", "CHEM12", "CHEM13", "CHEM23", "CHEM24", "CHEM29", "PAP2",
     "PAP4", "PAP5", "PAP7", "PAP9",
 ];
-
-/// A small CSV reader: header line, then numbers (the ISDB files are plain).
-fn read_csv(path: &Path) -> Option<(Vec<String>, Vec<Vec<String>>)> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let mut lines = text.lines();
-    let header: Vec<String> = lines
-        .next()?
-        .split(',')
-        .map(|s| s.trim().to_string())
-        .collect();
-    let rows = lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').map(|s| s.trim().to_string()).collect())
-        .collect();
-    Some((header, rows))
-}
-
-fn column(header: &[String], rows: &[Vec<String>], name: &str) -> Vec<f64> {
-    let i = header
-        .iter()
-        .position(|h| h.eq_ignore_ascii_case(name))
-        .expect("column");
-    rows.iter().map(|r| r[i].parse().expect("number")).collect()
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
