@@ -224,7 +224,7 @@ pub fn sampling_time(t: &[f64]) -> Option<f64> {
 }
 
 /// The delimiter the header line uses most: comma, semicolon or tab.
-fn sniff_delimiter(header: &str) -> u8 {
+pub fn sniff_delimiter(header: &str) -> u8 {
     [b',', b';', b'\t']
         .into_iter()
         .max_by_key(|&d| header.bytes().filter(|&b| b == d).count())

@@ -8,7 +8,7 @@
 //! `stiction`, the closed-loop estimate (`quantify`) sizes the band beside the ellipse estimate.
 
 use crate::detect::{self, CrossCorrelation, IaeCount, IaeSettings, Regularity, ShapeIndex};
-use crate::quality::{self, Finding, Limits, Record};
+use crate::quality::{self, Finding, Limits};
 use crate::quantify::{quantify, Quantification, QuantifyRequest};
 use crate::spectral::{self, BicoherenceSettings};
 use crate::{Method, ModelKind};
@@ -799,20 +799,9 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
         // mode do not break (they excite it): the whole record is used unless its time axis has
         // gaps, and the valve then starts from a known state more often (its initial position
         // is not estimated)
-        let whole_ok = r.time.is_none_or(|t| {
-            quality::check(
-                &Record {
-                    op: r.op,
-                    pv: r.pv,
-                    sp: None,
-                    time: Some(t),
-                    auto: None,
-                },
-                &req.limits,
-            )
-            .iter()
-            .all(|f| f.gate != "time_gaps" || f.passed)
-        });
+        let whole_ok = r
+            .time
+            .is_none_or(|t| quality::time_gaps(t, &req.limits).passed);
         let (qs, qe) = if whole_ok { (0, n) } else { (s, e) };
         match quantify(&r.op[qs..qe], &r.pv[qs..qe], &q) {
             Ok(qr) => {

@@ -171,29 +171,35 @@ pub fn check(r: &Record, limits: &Limits) -> Vec<Finding> {
     }
 
     if let Some(t) = r.time {
-        let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-        let backwards = steps.iter().filter(|&&s| s <= 0.0).count();
-        steps.sort_by(f64::total_cmp);
-        let ts = steps.get(steps.len() / 2).copied().unwrap_or(0.0);
-        let gaps = if ts > 0.0 {
-            t.windows(2)
-                .filter(|w| w[1] - w[0] > limits.gap_steps * ts)
-                .count()
-        } else {
-            0
-        };
-        out.push(finding(
-            "time_gaps",
-            gaps == 0 && backwards == 0 && ts > 0.0,
-            gaps as f64,
-            0.0,
-            format!(
-                "{gaps} gaps longer than {} sampling times, {backwards} steps where time does not increase",
-                limits.gap_steps
-            ),
-        ));
+        out.push(time_gaps(t, limits));
     }
     out
+}
+
+/// The time-axis gate: gaps longer than `limits.gap_steps` sampling times, or steps where time
+/// does not increase.
+pub fn time_gaps(t: &[f64], limits: &Limits) -> Finding {
+    let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let backwards = steps.iter().filter(|&&s| s <= 0.0).count();
+    steps.sort_by(f64::total_cmp);
+    let ts = steps.get(steps.len() / 2).copied().unwrap_or(0.0);
+    let gaps = if ts > 0.0 {
+        t.windows(2)
+            .filter(|w| w[1] - w[0] > limits.gap_steps * ts)
+            .count()
+    } else {
+        0
+    };
+    finding(
+        "time_gaps",
+        gaps == 0 && backwards == 0 && ts > 0.0,
+        gaps as f64,
+        0.0,
+        format!(
+            "{gaps} gaps longer than {} sampling times, {backwards} steps where time does not increase",
+            limits.gap_steps
+        ),
+    )
 }
 
 #[cfg(test)]

@@ -5,6 +5,7 @@
 //! `write_loop_report` calls `crate::cmd_report::write_report` instead.
 
 use super::summary::{Row, VERDICTS};
+use crate::cmd_report::esc;
 use crate::cmd_simulate::write_atomic;
 use anyhow::Result;
 use std::fmt::Write as _;
@@ -15,21 +16,6 @@ table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:
 th{background:#f3f3f3}td.n{text-align:right;font-variant-numeric:tabular-nums}\
 .stiction{color:#b00020;font-weight:bold}.undetermined{color:#a66a00}.no_stiction{color:#1b5e20}\
 .insufficient_data{color:#555}.failed{color:#b00020}small{color:#666}";
-
-pub fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
 
 fn num(v: Option<f64>, decimals: usize) -> String {
     match v {
@@ -42,7 +28,7 @@ fn num(v: Option<f64>, decimals: usize) -> String {
 fn page(title: &str, body: &str) -> String {
     format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head>\n<body>\n{body}</body></html>\n",
-        escape(title)
+        esc(title)
     )
 }
 
@@ -76,24 +62,24 @@ pub fn write_index(outdir: &Path, rows: &[Row], complete: bool) -> Result<()> {
         let name = if r.report {
             format!(
                 "<a href=\"reports/{}.html\">{}</a>",
-                escape(&r.loop_id),
-                escape(&r.loop_id)
+                esc(&r.loop_id),
+                esc(&r.loop_id)
             )
         } else {
-            escape(&r.loop_id)
+            esc(&r.loop_id)
         };
         let _ = writeln!(
             b,
             "<tr><td class=\"n\">{}</td><td>{name}<br><small>{}</small></td><td class=\"{}\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td></tr>",
             k + 1,
-            escape(&r.source),
-            escape(&r.verdict),
-            escape(&r.verdict.replace('_', " ")),
+            esc(&r.source),
+            esc(&r.verdict),
+            esc(&r.verdict.replace('_', " ")),
             num(r.confidence, 2),
             num(Some(r.severity), 3),
             num(r.apparent_stiction_closed_loop.or(r.apparent_stiction_ellipse), 3),
             num(r.period_s, 1),
-            escape(&r.reason)
+            esc(&r.reason)
         );
     }
     let _ = writeln!(b, "</table>");

@@ -122,14 +122,6 @@ pub fn expand(args: &[String]) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-/// The delimiter the header line uses most: comma, semicolon or tab (as `data::Table` decides).
-fn sniff_delimiter(header: &str) -> u8 {
-    [b',', b';', b'\t']
-        .into_iter()
-        .max_by_key(|&d| header.bytes().filter(|&b| b == d).count())
-        .unwrap_or(b',')
-}
-
 /// The header line of a file (without a byte-order mark), or `None` when it cannot be read.
 fn header_line(path: &Path) -> Option<String> {
     let mut r = BufReader::new(std::fs::File::open(path).ok()?);
@@ -164,7 +156,7 @@ pub fn classify(files: Vec<PathBuf>, loop_id_col: &str, columns: &Columns) -> Re
             sources.push(Source::File(path));
             continue;
         };
-        let delimiter = sniff_delimiter(&line);
+        let delimiter = crate::data::sniff_delimiter(&line);
         let headers = split_header(&line, delimiter);
         let find = |name: &str| {
             headers
