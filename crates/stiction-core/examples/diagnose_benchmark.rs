@@ -52,11 +52,12 @@ fn vote_cell(d: &Diagnosis, name: &str) -> String {
         })
 }
 
-const INDEX_COLUMNS: [&str; 5] = [
+const INDEX_COLUMNS: [&str; 6] = [
     "cross_correlation",
     "ddpv_histogram",
     "bicoherence",
     "curve_fitting",
+    "harmonics",
     "shape",
 ];
 

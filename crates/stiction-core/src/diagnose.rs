@@ -81,6 +81,12 @@ pub struct Index {
     pub vote: Vote,
     /// Its weight in the verdict.
     pub weight: f64,
+    /// Set for an index that can vote only one way (the shape index confirms stiction, the
+    /// harmonics index confirms a linear oscillation): when it does not cast that vote it is
+    /// silent by design and is left out of the verdict's total weight, so its silence does not
+    /// dilute the other indices.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub only_votes: Option<Vote>,
     /// Why it voted as it did, or why it could not vote.
     pub note: String,
 }
@@ -412,6 +418,7 @@ fn horch_index(c: &CrossCorrelation) -> Index {
         ),
         vote: Vote::from_str(&c.vote),
         weight: 1.0,
+        only_votes: None,
         note: match c.oddness {
             None => "no zero crossing on both sides of lag 0".into(),
             Some(_) => format!(
@@ -429,6 +436,7 @@ fn shape_row(
     s: &ShapeIndex,
     threshold: String,
     weight: f64,
+    only_votes: Option<Vote>,
     on: &str,
 ) -> Index {
     Index {
@@ -438,6 +446,7 @@ fn shape_row(
         threshold,
         vote: Vote::from_str(&s.vote),
         weight,
+        only_votes,
         note: if s.half_cycles < 4 {
             format!("only {} usable half cycles of {on}", s.half_cycles)
         } else {
@@ -476,6 +485,7 @@ fn indices(
             threshold: "bimodality coefficient: one peak (stiction) below 0.4, two peaks (sinusoid) above 0.555".into(),
             vote,
             weight: 1.0,
+            only_votes: None,
             note: format!("PV smoothed over {w} samples"),
         });
     } else {
@@ -502,6 +512,7 @@ fn indices(
             cf.stiction_above, cf.no_stiction_below
         ),
         1.0,
+        None,
         cf_name,
     ));
     let mut shape = detect::shape_index(&e_s, 2.0 * osc.noise_std.max(1e-12));
@@ -510,15 +521,56 @@ fn indices(
     if shape.vote == "no_stiction" {
         shape.vote = "undetermined".into();
     }
+    out.push(harmonics_index(op, pv, osc, ts));
     out.push(shape_row(
         "shape",
         "Hägglund (2011): sine vs square fits of the control error per half period",
         &shape,
         "square-like (stiction) above 0; sine-like (0 or below) does not rule stiction out".into(),
         0.5,
+        Some(Vote::Stiction),
         "the control error",
     ));
     out
+}
+
+/// Harmonics below this share of the fundamental's power, in OP and in PV, make an oscillation
+/// sinusoidal: less than a triangle wave's 1/81 + 1/625 = 0.014.
+pub const SINUSOIDAL_HARMONICS: f64 = 0.01;
+
+/// A sticky valve moves in jumps, which put harmonics of the oscillation into MV and so into PV
+/// and, through the controller, OP (the effect the bicoherence test looks for through phase
+/// coupling; measured here directly as power). An oscillation that is sinusoidal in both OP and
+/// PV is a linear one (tuning, an external disturbance): the index then votes "no stiction". It
+/// never votes "stiction": noise, other non-linearities and aggressive tuning add harmonics too.
+fn harmonics_index(op: &[f64], pv: &[f64], osc: &Oscillation, ts: f64) -> Index {
+    let f0 = osc.period.map(|p| ts / p);
+    let h_op = f0.and_then(|f| spectral::harmonic_distortion(op, f, 5));
+    let h_pv = f0.and_then(|f| spectral::harmonic_distortion(pv, f, 5));
+    let value = match (h_op, h_pv) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        _ => None,
+    };
+    let vote = match value {
+        Some(h) if h < SINUSOIDAL_HARMONICS => Vote::NoStiction,
+        _ => Vote::Undetermined,
+    };
+    Index {
+        name: "harmonics".into(),
+        reference: "harmonic distortion of the oscillation (a valve's jumps put harmonics into OP and PV; cf. Choudhury, Shah and Thornhill 2004)".into(),
+        value,
+        threshold: format!(
+            "sinusoidal (no stiction) when harmonics 2 to 5 carry less than {} of the fundamental's power in both OP and PV (a triangle wave: 0.014); never votes stiction",
+            SINUSOIDAL_HARMONICS
+        ),
+        vote,
+        weight: 1.0,
+        only_votes: Some(Vote::NoStiction),
+        note: match (h_op, h_pv) {
+            (Some(a), Some(b)) => format!("OP {a:.4}, PV {b:.4} of the fundamental's power; value shown: the larger"),
+            _ => "no period, or fewer than 2 periods".into(),
+        },
+    }
 }
 
 /// Choudhury, Shah and Thornhill (2004): the squared bicoherence of the control error; a
@@ -544,6 +596,7 @@ fn bicoherence_index(error: &[f64]) -> Index {
             threshold,
             vote: Vote::Undetermined,
             weight: 0.0,
+            only_votes: None,
             note: format!(
                 "too few samples for {} segments",
                 spectral::MIN_SEGMENTS
@@ -562,6 +615,7 @@ fn bicoherence_index(error: &[f64]) -> Index {
                 Vote::Undetermined
             },
             weight: 0.0,
+            only_votes: None,
             note: format!(
                 "NGI {:.4}, NLI {:.3} ({} segments of {}); value shown: NGI; not counted in the verdict",
                 b.ngi, b.nli, b.segments, b.segment_length
@@ -572,7 +626,9 @@ fn bicoherence_index(error: &[f64]) -> Index {
 
 /// Combine the votes: a weighted mean of +1 (stiction), -1 (no stiction), 0 (undetermined).
 fn combine(indices: &[Index], margin: f64) -> (Verdict, f64) {
-    let total: f64 = indices.iter().map(|i| i.weight).sum();
+    // a one-sided index that does not cast its vote is silent by design: not counted
+    let counted = |i: &&Index| i.only_votes.is_none() || i.vote != Vote::Undetermined;
+    let total: f64 = indices.iter().filter(counted).map(|i| i.weight).sum();
     if total <= 0.0 {
         return (Verdict::Undetermined, 0.0);
     }
@@ -751,13 +807,42 @@ fn judge(r: &LoopRecord, whole: usize, (s, e): (usize, usize), req: &DiagnoseReq
     }
 }
 
+/// Below this share of the PV's variation above its noise explained by OP (closed-loop fit), a
+/// stiction verdict is overturned: the valve does not drive the oscillation.
+pub const MIN_EXPLAINED_BY_OP: f64 = 0.3;
+
+/// The share of the PV's variation above its measurement noise that a simulation with R² `r2`
+/// explains: `1 - (unexplained - noise) / (1 - noise)`, shares of the output's variance (PV, or
+/// its change per sample for an integrating fit). `None` when the output has no variance above
+/// the noise.
+fn signal_explained(pv: &[f64], output: &str, r2: f64) -> Option<f64> {
+    let (var, noise_var) = if output == "delta_pv" {
+        let d: Vec<f64> = pv.windows(2).map(|w| w[1] - w[0]).collect();
+        let m = mean(&d);
+        let v = d.iter().map(|x| (x - m).powi(2)).sum::<f64>() / d.len().max(1) as f64;
+        (v, 2.0 * noise_std(pv).powi(2))
+    } else {
+        let m = mean(pv);
+        let v = pv.iter().map(|x| (x - m).powi(2)).sum::<f64>() / pv.len().max(1) as f64;
+        (v, noise_std(pv).powi(2))
+    };
+    if var.is_nan() || var <= 0.0 || !r2.is_finite() {
+        return None;
+    }
+    let noise = noise_var / var;
+    if noise.is_nan() || noise >= 0.95 {
+        return None;
+    }
+    Some(1.0 - ((1.0 - r2) - noise) / (1.0 - noise))
+}
+
 /// Diagnose one loop.
 pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, DiagnoseError> {
     let started = Instant::now();
     check(r, req)?;
     let n = r.op.len();
     let (s, e) = usable_stretch(r);
-    let stretch = judge(r, n, (s, e), req);
+    let mut stretch = judge(r, n, (s, e), req);
     let mut warnings = Vec::new();
     if r.sp.is_none() {
         warnings.push(
@@ -808,6 +893,39 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
                 if let Some(a) = apparent.as_mut() {
                     a.closed_loop = qr.apparent_stiction;
                     a.closed_loop_interval = qr.interval.get("d").copied();
+                }
+                // the indices read the shape and phase of the oscillation; the closed-loop fit
+                // asks whether OP, through a valve (sticky or not) and a linear process, drives
+                // it at all. If not, the oscillation enters the loop elsewhere.
+                let fit = qr.fit.as_ref();
+                let pv_q = &r.pv[qs..qe];
+                let explained =
+                    fit.and_then(|f| signal_explained(pv_q, &f.output, f.r2_simulation));
+                let without = fit.and_then(|f| {
+                    f.r2_simulation_without_stiction
+                        .and_then(|r2| signal_explained(pv_q, &f.output, r2))
+                });
+                if let Some(explained) = explained {
+                    if explained < MIN_EXPLAINED_BY_OP {
+                        let why = format!(
+                            "the indices point to stiction, but OP explains only {:.0} % of the PV's variation above its noise through any valve and linear process \
+                             (closed-loop fit; at least {:.0} % expected when the valve drives the oscillation): \
+                             the oscillation enters the loop elsewhere, e.g. an external disturbance",
+                            100.0 * explained.max(0.0),
+                            100.0 * MIN_EXPLAINED_BY_OP
+                        );
+                        stretch.verdict = Verdict::NoStiction;
+                        stretch.confidence = (1.0 - explained).clamp(0.0, 1.0);
+                        stretch.evidence.push(why.clone());
+                        stretch.reason = Some(why);
+                        apparent = None;
+                    } else {
+                        stretch.evidence.push(format!(
+                            "closed-loop fit: OP explains {:.0} % of the PV's variation above its noise with the stiction model ({} without stiction)",
+                            100.0 * explained,
+                            without.map_or("-".into(), |w| format!("{:.0} %", 100.0 * w.max(0.0)))
+                        ));
+                    }
                 }
                 quantification = Some(qr);
                 quantified = Some([qs, qe]);

@@ -181,3 +181,92 @@ fn integrating_loops_use_the_second_difference_histogram() {
     assert_eq!(ddpv.vote, Vote::Stiction);
     assert!(d.indices.iter().all(|i| i.name != "cross_correlation"));
 }
+
+#[test]
+fn a_sinusoidal_oscillation_is_linear_whatever_its_phase() {
+    // a slow disturbance against an integral-dominated controller puts OP about 90 degrees
+    // behind PV, which Horch's cross-correlation reads as stiction; OP and PV are sinusoids,
+    // which the harmonics index reads as a linear oscillation
+    let disturbed = run(0.0, |cl| {
+        cl.process = Process::Foptd {
+            k: 3.0,
+            tau: 10.0,
+            delay: 10.0,
+        };
+        cl.pi.kc = 0.2;
+        cl.pi.ti = 10.0;
+        cl.noise = 0.02;
+        cl.disturbance = Some(Signal::Sine {
+            amplitude: 1.0,
+            period: 150.0,
+            offset: 0.0,
+        });
+    });
+    let d = diagnose(&record(&disturbed), &quick()).unwrap();
+    let vote = |name: &str| d.indices.iter().find(|i| i.name == name).unwrap().vote;
+    assert_eq!(vote("harmonics"), Vote::NoStiction, "{:#?}", d.indices);
+    assert_eq!(d.verdict, Verdict::NoStiction, "{:#?}", d.evidence);
+
+    // a sticky valve's jumps put harmonics into the loop: the index stays silent
+    let sticky = run(2.0, |_| {});
+    let d = diagnose(&record(&sticky), &quick()).unwrap();
+    let h = d.indices.iter().find(|i| i.name == "harmonics").unwrap();
+    assert_eq!(h.vote, Vote::Undetermined, "{h:#?}");
+    assert!(h.value.unwrap() > 0.01);
+}
+
+#[test]
+fn an_oscillation_that_op_does_not_drive_is_not_stiction() {
+    // OP ramps up and down like a controller behind a sticky valve, but the PV's oscillation
+    // (another period, square) does not come from it: the shape indices see stiction, the
+    // closed-loop fit finds that OP explains almost none of the PV
+    let n = 3000;
+    let mut state = 7u64;
+    let mut noise = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.02
+    };
+    let op: Vec<f64> = (0..n)
+        .map(|i| {
+            let p = (i as f64 / 100.0).fract();
+            50.0 + if p < 0.5 {
+                4.0 * p - 1.0
+            } else {
+                3.0 - 4.0 * p
+            } + noise()
+        })
+        .collect();
+    let pv: Vec<f64> = (0..n)
+        .map(|i| {
+            let p = (i as f64 / 37.0).fract();
+            10.0 + if p < 0.5 { 1.0 } else { -1.0 } + noise()
+        })
+        .collect();
+    let rec = LoopRecord {
+        op: &op,
+        pv: &pv,
+        sp: None,
+        time: None,
+        auto: None,
+    };
+    let without = diagnose(&rec, &quick()).unwrap();
+    let with = diagnose(&rec, &DiagnoseRequest::default()).unwrap();
+    assert_eq!(
+        without.verdict,
+        Verdict::Stiction,
+        "{:#?}",
+        without.evidence
+    );
+    assert_eq!(with.verdict, Verdict::NoStiction, "{:#?}", with.evidence);
+    assert!(
+        with.reason
+            .as_deref()
+            .unwrap()
+            .contains("enters the loop elsewhere"),
+        "{:?}",
+        with.reason
+    );
+    assert!(with.apparent_stiction.is_none());
+}
