@@ -207,8 +207,9 @@ pub fn welch_psd(x: &[f64], segment: usize) -> Vec<f64> {
 }
 
 /// Harmonic distortion of an oscillation of frequency `f0` (cycles per sample): the power in
-/// the bands around its harmonics `2 f0 ..= harmonics f0` over the power in the band around
-/// `f0` (each band ±0.3 f0 wide), from a Welch spectrum with segments of 8 periods (at least 256
+/// the bands around its harmonics `2 f0 ..= harmonics f0`, less the white-noise floor (the median
+/// of the spectrum above the highest band), over the power in the band around `f0` (each band
+/// ±0.3 f0 wide), from a Welch spectrum with segments of 8 periods (at least 256
 /// samples, at most the record). With `harmonics = 5`, a sinusoid gives about 0, a triangle wave
 /// 0.014 (1/81 + 1/625), a square wave 0.15 (1/9 + 1/25). `None` when the record holds fewer than 2 periods or the fundamental band is empty.
 pub fn harmonic_distortion(x: &[f64], f0: f64, harmonics: usize) -> Option<f64> {
@@ -222,15 +223,31 @@ pub fn harmonic_distortion(x: &[f64], f0: f64, harmonics: usize) -> Option<f64> 
         return None;
     }
     let df = 1.0 / segment as f64;
+    // white measurement noise is not harmonics: the median of the spectrum above the highest
+    // band (where only noise is left) is taken off every harmonic bin
+    let top = (harmonics as f64 + 1.0) * f0;
+    let mut above: Vec<f64> = psd
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| *j as f64 * df > top)
+        .map(|(_, &p)| p)
+        .collect();
+    let floor = if above.len() >= 8 {
+        above.sort_by(f64::total_cmp);
+        above[above.len() / 2]
+    } else {
+        0.0
+    };
     let band = |k: f64| -> f64 {
         let (lo, hi) = ((k - 0.3) * f0, (k + 0.3) * f0);
+        let floor = if k > 1.0 { floor } else { 0.0 };
         psd.iter()
             .enumerate()
             .filter(|(j, _)| {
                 let f = *j as f64 * df;
                 f > lo && f < hi && *j > 0
             })
-            .map(|(_, p)| p)
+            .map(|(_, p)| (p - floor).max(0.0))
             .sum()
     };
     let fundamental = band(1.0);
@@ -849,6 +866,23 @@ mod tests {
             "triangle {ht}"
         );
         assert!((hq - (1.0 / 9.0 + 1.0 / 25.0)).abs() < 0.01, "square {hq}");
+        // white measurement noise on a sinusoid is not harmonics
+        let mut state = 3u64;
+        let noisy: Vec<f64> = sine
+            .iter()
+            .map(|v| {
+                let mut g = 0.0;
+                for _ in 0..12 {
+                    state = state
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    g += (state >> 11) as f64 / (1u64 << 53) as f64;
+                }
+                v + 0.3 * (g - 6.0)
+            })
+            .collect();
+        let hn = harmonic_distortion(&noisy, f0, 5).unwrap();
+        assert!(hn < 0.01, "noisy sine {hn}");
         // fewer than two periods: no answer
         assert!(harmonic_distortion(&sine[..80], f0, 5).is_none());
     }
