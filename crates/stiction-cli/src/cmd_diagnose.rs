@@ -187,11 +187,23 @@ pub fn print_human(file: &str, d: &Diagnosis) {
                 i.threshold,
                 if i.weight == 0.0 {
                     " [shown, not counted]"
+                } else if i.only_votes.is_some() && i.vote == Vote::Undetermined {
+                    " [one-sided: silent]"
                 } else {
                     ""
                 }
             );
         }
+    }
+    if let Some(c) = &d.closed_loop_check {
+        println!(
+            "  closed-loop check: OP explains {:.0} % of the PV's variation above its noise ({} without stiction; at least {:.0} % for a valve-driven oscillation): {}",
+            100.0 * c.explained.max(0.0),
+            c.explained_without_stiction
+                .map_or("-".into(), |w| format!("{:.0} %", 100.0 * w.max(0.0))),
+            100.0 * c.limit,
+            if c.passed { "passed" } else { "failed" }
+        );
     }
     if let Some(a) = &d.apparent_stiction {
         if let Some(v) = a.closed_loop {

@@ -51,6 +51,10 @@ fn a_sticky_loop_is_stiction_with_the_band_sized() {
         .map(|i| i["name"].as_str().unwrap())
         .collect();
     assert!(names.contains(&"cross_correlation") && names.contains(&"curve_fitting"));
+    assert!(names.contains(&"harmonics") && names.contains(&"shape"));
+    // the valve drives this oscillation: the closed-loop check passes
+    assert_eq!(v["closed_loop_check"]["passed"], true, "{v:#}");
+    assert!(v["closed_loop_check"]["explained"].as_f64().unwrap() > 0.9);
     for i in v["indices"].as_array().unwrap() {
         assert!(i["threshold"].as_str().is_some() && i["vote"].as_str().is_some());
     }
@@ -61,6 +65,9 @@ fn a_sticky_loop_is_stiction_with_the_band_sized() {
     let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
     assert!(text.contains("STICTION"), "{text}");
     assert!(text.contains("cross_correlation"), "{text}");
+    assert!(!text.contains("closed-loop check"), "{text}");
+    let text = ok(&["diagnose", &f, "--sp", "sp"]);
+    assert!(text.contains("closed-loop check: OP explains"), "{text}");
 }
 
 #[test]

@@ -117,6 +117,20 @@ pub struct ApparentStiction {
     pub ellipse: Option<f64>,
 }
 
+/// The closed-loop check of a stiction verdict: how much of the PV's variation above its noise
+/// OP explains through the fitted valve and linear process. A valve that causes the oscillation
+/// explains most of it; below `limit` the verdict becomes `no_stiction` (the oscillation enters
+/// the loop elsewhere).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ClosedLoopCheck {
+    /// Share (0..1, may be negative) explained with the stiction model.
+    pub explained: f64,
+    /// The same through a valve without stiction (the best linear fit of the same family).
+    pub explained_without_stiction: Option<f64>,
+    pub limit: f64,
+    pub passed: bool,
+}
+
 /// The verdict for one window of the record.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WindowVerdict {
@@ -206,6 +220,9 @@ pub struct Diagnosis {
     /// axis has gaps: setpoint changes and manual mode do not break the OP -> PV relation).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub quantified: Option<[usize; 2]>,
+    /// Whether OP drives the oscillation: the closed-loop check of a stiction verdict.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub closed_loop_check: Option<ClosedLoopCheck>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub windows: Vec<WindowVerdict>,
     pub warnings: Vec<String>,
@@ -853,6 +870,7 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
     let mut apparent = None;
     let mut quantification = None;
     let mut quantified = None;
+    let mut closed_loop_check = None;
     if stretch.verdict == Verdict::Stiction {
         // the ellipse through the PV-OP plot filtered around the oscillation (Choudhury et al.)
         let ellipse = stretch
@@ -906,7 +924,14 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
                         .and_then(|r2| signal_explained(pv_q, &f.output, r2))
                 });
                 if let Some(explained) = explained {
-                    if explained < MIN_EXPLAINED_BY_OP {
+                    let passed = explained >= MIN_EXPLAINED_BY_OP;
+                    if passed {
+                        stretch.evidence.push(format!(
+                            "closed-loop fit: OP explains {:.0} % of the PV's variation above its noise with the stiction model ({} without stiction)",
+                            100.0 * explained,
+                            without.map_or("-".into(), |w| format!("{:.0} %", 100.0 * w.max(0.0)))
+                        ));
+                    } else {
                         let why = format!(
                             "the indices point to stiction, but OP explains only {:.0} % of the PV's variation above its noise through any valve and linear process \
                              (closed-loop fit; at least {:.0} % expected when the valve drives the oscillation): \
@@ -919,13 +944,13 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
                         stretch.evidence.push(why.clone());
                         stretch.reason = Some(why);
                         apparent = None;
-                    } else {
-                        stretch.evidence.push(format!(
-                            "closed-loop fit: OP explains {:.0} % of the PV's variation above its noise with the stiction model ({} without stiction)",
-                            100.0 * explained,
-                            without.map_or("-".into(), |w| format!("{:.0} %", 100.0 * w.max(0.0)))
-                        ));
                     }
+                    closed_loop_check = Some(ClosedLoopCheck {
+                        explained,
+                        explained_without_stiction: without,
+                        limit: MIN_EXPLAINED_BY_OP,
+                        passed,
+                    });
                 }
                 quantification = Some(qr);
                 quantified = Some([qs, qe]);
@@ -974,6 +999,7 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
         apparent_stiction: apparent,
         quantification,
         quantified,
+        closed_loop_check,
         windows,
         warnings,
         seconds: started.elapsed().as_secs_f64(),

@@ -269,4 +269,7 @@ fn an_oscillation_that_op_does_not_drive_is_not_stiction() {
         with.reason
     );
     assert!(with.apparent_stiction.is_none());
+    let check = with.closed_loop_check.unwrap();
+    assert!(!check.passed && check.explained < check.limit, "{check:?}");
+    assert!(without.closed_loop_check.is_none());
 }
