@@ -585,7 +585,7 @@ fn harmonics_index(op: &[f64], pv: &[f64], osc: &Oscillation, ts: f64) -> Index 
         only_votes: Some(Vote::NoStiction),
         note: match (h_op, h_pv) {
             (Some(a), Some(b)) => format!("OP {a:.4}, PV {b:.4} of the fundamental's power; value shown: the larger"),
-            _ => "no period, or fewer than 2 periods".into(),
+            _ => "no period, fewer than 2 periods, or a period too short for 5 harmonics below the Nyquist frequency (under 11 samples)".into(),
         },
     }
 }

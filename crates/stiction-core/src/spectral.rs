@@ -211,10 +211,14 @@ pub fn welch_psd(x: &[f64], segment: usize) -> Vec<f64> {
 /// of the spectrum above the highest band), over the power in the band around `f0` (each band
 /// ±0.3 f0 wide), from a Welch spectrum with segments of 8 periods (at least 256
 /// samples, at most the record). With `harmonics = 5`, a sinusoid gives about 0, a triangle wave
-/// 0.014 (1/81 + 1/625), a square wave 0.15 (1/9 + 1/25). `None` when the record holds fewer than 2 periods or the fundamental band is empty.
+/// 0.014 (1/81 + 1/625), a square wave 0.15 (1/9 + 1/25). `None` when the record holds fewer
+/// than 2 periods, the highest harmonic's band reaches the Nyquist frequency (periods shorter than
+/// about `2 harmonics + 1` samples), or the fundamental band is empty.
 pub fn harmonic_distortion(x: &[f64], f0: f64, harmonics: usize) -> Option<f64> {
     let n = x.len();
-    if !(f0 > 0.0) || (n as f64) * f0 < 2.0 {
+    // every harmonic's band must lie below the Nyquist frequency, or the missing ones would pass
+    // for a sinusoid
+    if !(f0 > 0.0) || (n as f64) * f0 < 2.0 || (harmonics as f64 + 0.3) * f0 > 0.5 {
         return None;
     }
     let segment = ((8.0 / f0).ceil() as usize).max(256).min(n);
@@ -883,7 +887,9 @@ mod tests {
             .collect();
         let hn = harmonic_distortion(&noisy, f0, 5).unwrap();
         assert!(hn < 0.01, "noisy sine {hn}");
-        // fewer than two periods: no answer
+        // fewer than two periods, or harmonics beyond the Nyquist frequency: no answer
+        assert!(harmonic_distortion(&sine, 1.0 / 8.0, 5).is_none());
+        assert!(harmonic_distortion(&sine, 1.0 / 12.0, 5).is_some());
         assert!(harmonic_distortion(&sine[..80], f0, 5).is_none());
     }
     use crate::models::{Model, Stenman};
