@@ -48,6 +48,11 @@ pub struct Args {
     /// search on the first samples (the default from 1,500 samples on)
     #[arg(long)]
     full: bool,
+    /// stenman exact: choose where the valve stood at the first sample (candidates across the
+    /// OP's span, each searched on the first samples; about 2-4x the time) instead of assuming it
+    /// had just moved to the first OP: for records that start mid-cycle
+    #[arg(long)]
+    estimate_start: bool,
     /// aco, aco-r: ants per iteration
     #[arg(long)]
     ants: Option<usize>,
@@ -91,6 +96,7 @@ pub fn run(a: Args) -> Result<()> {
     req.max_delay = a.max_delay;
     req.full_partition = !a.quick;
     req.staged = !a.full;
+    req.estimate_start = a.estimate_start;
     req.integrating = if a.integrating {
         Some(true)
     } else if a.self_regulating {
@@ -176,6 +182,16 @@ fn print_human(file: &str, q: &Quantification, plot_dir: Option<&Path>) {
             print!("; {what} [{lo:.4}, {hi:.4}]");
         }
         println!();
+    }
+    if let (Some(x0), Some(kind)) = (q.valve_start, q.valve_start_kind.as_deref()) {
+        println!(
+            "  valve at the first sample: {x0:.3} ({})",
+            match kind {
+                "estimated" => "estimated: the best of candidates across the OP's span",
+                "given" => "given",
+                _ => "assumed at the first OP; --estimate-start estimates it",
+            }
+        );
     }
     if let Some(lm) = &q.linear_model {
         let mut phys = Vec::new();

@@ -532,6 +532,13 @@ fn quantify_from_op_and_pv_json_and_plots() {
         "{human}"
     );
     assert!(human.contains("delay 11 samples"), "{human}");
+    assert!(
+        human.contains("valve at the first sample") && human.contains("--estimate-start"),
+        "{human}"
+    );
+    let v = json(&ok(&["quantify", &f, "--estimate-start", "--json"]));
+    assert_eq!(v["valve_start_kind"], "estimated", "{v:#}");
+    assert!(v["valve_start"].as_f64().is_some());
 }
 
 #[test]

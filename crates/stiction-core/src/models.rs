@@ -557,6 +557,33 @@ impl Model {
         mv
     }
 
+    /// Simulate with the valve at `start` at the first sample instead of at the first command
+    /// (Stenman and He, whose state is the valve position; the other models start as usual).
+    /// A record rarely begins just as the valve has moved: this is where it actually stood.
+    pub fn simulate_from_into(&self, op: &[f64], start: Option<f64>, mv: &mut [f64]) {
+        fn from<M: StictionModel<State = f64>>(m: &M, op: &[f64], x0: f64, mv: &mut [f64]) {
+            if op.is_empty() {
+                return;
+            }
+            let mut x = x0;
+            mv[0] = x0;
+            for (y, &u) in mv[1..].iter_mut().zip(&op[1..]) {
+                *y = m.step(&mut x, u);
+            }
+        }
+        match (self, start) {
+            (Model::Stenman(m), Some(x0)) => from(m, op, x0, mv),
+            (Model::He(m), Some(x0)) => from(m, op, x0, mv),
+            _ => self.simulate_into(op, mv),
+        }
+    }
+
+    pub fn simulate_from(&self, op: &[f64], start: Option<f64>) -> Vec<f64> {
+        let mut mv = vec![0.0; op.len()];
+        self.simulate_from_into(op, start, &mut mv);
+        mv
+    }
+
     pub fn sse(&self, op: &[f64], mv_measured: &[f64]) -> f64 {
         match self {
             Model::Stenman(m) => m.sse(op, mv_measured),

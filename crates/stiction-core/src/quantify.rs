@@ -47,6 +47,15 @@ pub struct QuantifyRequest {
     /// cell of the first samples', so this is exact over the cells kept). `false`: every cell of
     /// the whole record.
     pub staged: bool,
+    /// The valve position at the first sample (Stenman and He); `None`: where OP starts, as if
+    /// the valve had just moved there (unless `estimate_start` chooses one).
+    #[serde(default)]
+    pub valve_start: Option<f64>,
+    /// Stenman exact: choose the valve position at the first sample (a record rarely starts just
+    /// as the valve moved) among candidates across the OP's span, by the fit on the first samples.
+    /// Off by default: it costs about four more searches of the first samples.
+    #[serde(default)]
+    pub estimate_start: bool,
 }
 
 impl QuantifyRequest {
@@ -68,6 +77,8 @@ impl QuantifyRequest {
             integrating: None,
             full_partition: true,
             staged: true,
+            valve_start: None,
+            estimate_start: false,
         }
     }
 }
@@ -134,6 +145,13 @@ pub struct Quantification {
     /// Stenman with `exact`: the number of distinct valve trajectories.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cells: Option<usize>,
+    /// Stenman and He: the valve position the model starts from at the first sample, and how it
+    /// was chosen ("first_op": where OP starts; "estimated": the best of the candidates on the
+    /// first samples; "given").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub valve_start: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub valve_start_kind: Option<String>,
     pub seconds: f64,
     pub samples: usize,
     pub ts: f64,
@@ -169,6 +187,8 @@ impl Quantification {
             op_range,
             evaluations: 0,
             cells: None,
+            valve_start: None,
+            valve_start_kind: None,
             seconds: 0.0,
             samples: n,
             ts: req.ts,
@@ -196,21 +216,30 @@ struct Hammerstein<'a> {
     prepared: identify::Prepared<'a>,
     /// Subtracted from the valve position (the mean OP) to keep the normal equations well scaled.
     offset: f64,
+    /// The valve position at the first sample (`None`: the first OP).
+    start: Option<f64>,
 }
 
 impl<'a> Hammerstein<'a> {
-    fn new(kind: ModelKind, op: &'a [f64], data: &'a Data<'a>, structure: Structure) -> Self {
+    fn new(
+        kind: ModelKind,
+        op: &'a [f64],
+        data: &'a Data<'a>,
+        structure: Structure,
+        start: Option<f64>,
+    ) -> Self {
         Self {
             kind,
             op,
             prepared: identify::Prepared::new(data, structure),
             offset: op.iter().sum::<f64>() / op.len() as f64,
+            start,
         }
     }
 
     fn valve_into(&self, theta: &[f64], mv: &mut [f64]) {
         let model = self.kind.build(theta).expect("candidates are repaired");
-        model.simulate_into(self.op, mv);
+        model.simulate_from_into(self.op, self.start, mv);
         for v in mv.iter_mut() {
             *v -= self.offset;
         }
@@ -280,33 +309,119 @@ pub fn quantify(
 ) -> Result<Quantification, EstimateError> {
     let started = Instant::now();
     let n = op.len();
-    if req.model == ModelKind::Stenman
-        && req.method == Method::Exact
-        && req.staged
-        && n >= STAGE_FROM
-        && pv.len() == n
-    {
+    if !(req.model == ModelKind::Stenman && req.method == Method::Exact && pv.len() == n) {
+        return quantify_inner(op, pv, req, None).map(|r| r.0);
+    }
+    let staged = req.staged && n >= STAGE_FROM;
+    let estimate_start = req.estimate_start && req.valve_start.is_none();
+    // the first samples: at least a few oscillation periods (too short a start ranks the
+    // cells by the transient)
+    let m = if n >= STAGE_FROM {
+        let period = crate::detect::regularity(pv, 1.0).period.unwrap_or(0.0);
+        STAGE_SAMPLES
+            .max((STAGE_PERIODS * period) as usize)
+            .min(n / 2)
+    } else {
+        n
+    };
+    let mut req = req.clone();
+    let mut extra = 0;
+    let mut at_first_op = None;
+    if estimate_start {
+        // where the valve stood at the first sample: the candidate whose search of the first
+        // samples fits best (the first OP is one of them); it must then also fit the whole
+        // record better than the first OP does
+        let (best, evaluations) = best_start(&op[..m], &pv[..m], &req);
+        extra += evaluations;
+        if best.is_some_and(|x0| x0 != op[0]) {
+            let mut plain = req.clone();
+            plain.estimate_start = false;
+            at_first_op = Some(quantify(op, pv, &plain)?);
+        }
+        req.valve_start = best;
+    }
+    let finish = |mut q: Quantification, extra: u64| {
+        q.evaluations += extra;
+        q.seconds = started.elapsed().as_secs_f64();
+        if estimate_start && q.valve_start.is_some() {
+            q.valve_start_kind = Some("estimated".into());
+        }
+        q
+    };
+    let mut answer = None;
+    if staged {
         // stage 1: the whole d-range on the first samples (same valve start, so every
         // whole-record cell lies inside one of its cells)
-        // at least a few oscillation periods: too short a start ranks the cells by the transient
-        let period = crate::detect::regularity(pv, 1.0).period.unwrap_or(0.0);
-        let m = STAGE_SAMPLES
-            .max((STAGE_PERIODS * period) as usize)
-            .min(n / 2);
         let mut first = req.clone();
         first.staged = false;
         first.full_partition = true;
-        let stage = quantify_inner(&op[..m], &pv[..m], &first, None).ok();
-        if let Some((q, hint)) = stage {
+        if let Ok((q, hint)) = quantify_inner(&op[..m], &pv[..m], &first, None) {
             if q.status == "ok" && !hint.ranges.is_empty() {
-                let (mut full, _) = quantify_inner(op, pv, req, Some(&hint))?;
-                full.evaluations += q.evaluations;
-                full.seconds = started.elapsed().as_secs_f64();
-                return Ok(full);
+                let (full, _) = quantify_inner(op, pv, &req, Some(&hint))?;
+                extra += q.evaluations;
+                answer = Some(full);
             }
         }
     }
-    quantify_inner(op, pv, req, None).map(|r| r.0)
+    let answer = match answer {
+        Some(a) => a,
+        None => quantify_inner(op, pv, &req, None)?.0,
+    };
+    let sse = |q: &Quantification| q.fit.as_ref().map_or(f64::INFINITY, |f| f.sse_simulation);
+    Ok(match at_first_op {
+        Some(plain) if sse(&plain) <= sse(&answer) => {
+            let spent = answer.evaluations;
+            finish(plain, extra + spent)
+        }
+        Some(plain) => {
+            let spent = plain.evaluations;
+            finish(answer, extra + spent)
+        }
+        None => finish(answer, extra),
+    })
+}
+
+/// A record rarely starts just as the valve moved, and a Stenman valve started elsewhere can stay
+/// out of step with the real one for good. Each candidate position at the first sample (the first
+/// OP and a spread across the span OP covers) gets a search of `op`, `pv` (the exact search
+/// around its best grid points); the one that fits best is returned, with the evaluations spent.
+fn best_start(op: &[f64], pv: &[f64], req: &QuantifyRequest) -> (Option<f64>, u64) {
+    let mut local = req.clone();
+    local.staged = false;
+    local.full_partition = false;
+    let mut evaluations = 0;
+    let mut best: Option<(f64, f64)> = None;
+    for x0 in start_candidates(op) {
+        local.valve_start = Some(x0);
+        let Ok((q, _)) = quantify_inner(op, pv, &local, None) else {
+            continue;
+        };
+        evaluations += q.evaluations;
+        if let Some(sse) = q.fit.as_ref().map(|f| f.sse_simulation) {
+            if q.status == "ok" && best.is_none_or(|b| sse < b.0) {
+                best = Some((sse, x0));
+            }
+        }
+    }
+    (best.map(|b| b.1), evaluations)
+}
+
+/// Candidate valve positions at the first sample: the first OP, and a spread across the span
+/// OP covers in `op` (a valve that sticks stands anywhere within its band of the command).
+fn start_candidates(op: &[f64]) -> Vec<f64> {
+    let Some(&u0) = op.first() else {
+        return Vec::new();
+    };
+    let (lo, hi) = range(op);
+    let span = hi - lo;
+    let mut out = vec![u0];
+    for f in [-0.5, -0.25, 0.25, 0.5] {
+        let x = (u0 + f * span).clamp(lo, hi);
+        if out.iter().all(|&y| (y - x).abs() > 0.05 * span) {
+            out.push(x);
+        }
+    }
+    out
 }
 
 /// What a staged search carries from the first samples to the whole record.
@@ -398,7 +513,11 @@ fn quantify_inner(
         .par_iter()
         .filter_map(|theta| {
             let model = req.model.build(theta).ok()?;
-            identify::select(&data, &identify::centred(&model.simulate(op)), &search)
+            identify::select(
+                &data,
+                &identify::centred(&model.simulate_from(op, req.valve_start)),
+                &search,
+            )
         })
         .collect();
     evaluations += pilots.len() as u64;
@@ -438,12 +557,13 @@ fn quantify_inner(
     // the structure of a valve without stiction is always searched: the answer is then never
     // worse than the linear loop it is compared with
     let lows: Vec<f64> = bounds.iter().map(|b| b.0).collect();
-    if let Some(sel) = req
-        .model
-        .build(&lows)
-        .ok()
-        .and_then(|m| identify::select(&data, &identify::centred(&m.simulate(op)), &search))
-    {
+    if let Some(sel) = req.model.build(&lows).ok().and_then(|m| {
+        identify::select(
+            &data,
+            &identify::centred(&m.simulate_from(op, req.valve_start)),
+            &search,
+        )
+    }) {
         if !queue.contains(&sel.structure) {
             queue.push_back(sel.structure);
         }
@@ -477,7 +597,7 @@ fn quantify_inner(
         }
         let problems: Vec<Hammerstein> = round
             .iter()
-            .map(|&s| Hammerstein::new(req.model, op, &data, s))
+            .map(|&s| Hammerstein::new(req.model, op, &data, s, req.valve_start))
             .collect();
         let outcomes = match req.method {
             Method::Exact => exact_stenman(
@@ -557,7 +677,7 @@ fn quantify_inner(
     };
     let (structure, outcome, _) = tried.into_iter().next().expect("at least one search ran");
 
-    let problem = Hammerstein::new(req.model, op, &data, structure);
+    let problem = Hammerstein::new(req.model, op, &data, structure, req.valve_start);
     let Some(fit) = problem.fit(&outcome.best) else {
         return insufficient("the best valve trajectory leaves the linear fit singular".into());
     };
@@ -565,7 +685,7 @@ fn quantify_inner(
         return insufficient("no candidate gives a stable simulation of the PV".into());
     }
     let model = req.model.build(&outcome.best).expect("repaired");
-    let mv = model.simulate(op);
+    let mv = model.simulate_from(op, req.valve_start);
     let pv_simulated = identify::simulate_pv(&data, &problem.valve(&outcome.best), &fit);
     let phys = identify::physical(&fit, req.ts);
     let names = req.model.param_names();
@@ -669,6 +789,16 @@ fn quantify_inner(
             op_range,
             evaluations,
             cells: outcome.cells,
+            valve_start: matches!(req.model, ModelKind::Stenman | ModelKind::He)
+                .then(|| req.valve_start.unwrap_or(op[0])),
+            valve_start_kind: matches!(req.model, ModelKind::Stenman | ModelKind::He).then(|| {
+                if req.valve_start.is_some() {
+                    "given"
+                } else {
+                    "first_op"
+                }
+                .to_string()
+            }),
             seconds: started.elapsed().as_secs_f64(),
             samples: n,
             ts: req.ts,
@@ -881,7 +1011,8 @@ fn exact_stenman(
                 let mut out = Vec::new();
                 let mut bounds = start_bounds.clone();
                 let mut sums: Vec<identify::ValveSums> = Vec::new();
-                exact::stenman_walk(problems[0].op, chunk, (lo, hi), mv, |cell, mv| {
+                let x0 = problems[0].start.unwrap_or(problems[0].op[0]);
+                exact::stenman_walk(problems[0].op, x0, chunk, (lo, hi), mv, |cell, mv| {
                     for v in mv.iter_mut() {
                         *v -= offset;
                     }

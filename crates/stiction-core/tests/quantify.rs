@@ -140,3 +140,61 @@ fn loops_that_cannot_be_judged_say_why() {
     )
     .is_err());
 }
+
+#[test]
+fn a_record_that_starts_mid_cycle_needs_the_valve_start_estimated() {
+    // a sticky loop's record cut 20 samples in: the valve no longer stands where OP starts
+    let mut cl = ClosedLoop::new(Model::Stenman(Stenman { d: 1.0 }));
+    cl.samples = 2000;
+    cl.noise = 0.05;
+    cl.seed = 3;
+    let data = cl.run().unwrap();
+    let (op, pv) = (&data.op[20..], &data.pv[20..]);
+    let plain = quantify(
+        op,
+        pv,
+        &QuantifyRequest::new(ModelKind::Stenman, Method::Exact),
+    )
+    .unwrap();
+    let mut req = QuantifyRequest::new(ModelKind::Stenman, Method::Exact);
+    req.estimate_start = true;
+    let estimated = quantify(op, pv, &req).unwrap();
+    assert_eq!(plain.valve_start_kind.as_deref(), Some("first_op"));
+    assert_eq!(plain.valve_start, Some(op[0]));
+    assert_eq!(estimated.valve_start_kind.as_deref(), Some("estimated"));
+    let d = estimated.params["d"];
+    assert!((d - 1.0).abs() < 0.1, "estimated start: d = {d}");
+    let sse = |q: &stiction_core::quantify::Quantification| q.fit.as_ref().unwrap().sse_simulation;
+    // never worse than starting at the first OP, here much better
+    assert!(
+        sse(&estimated) < 0.5 * sse(&plain),
+        "{} vs {}",
+        sse(&estimated),
+        sse(&plain)
+    );
+    // the true valve position at the cut, within the band of the estimate
+    let x0 = estimated.valve_start.unwrap();
+    assert!(
+        (x0 - data.mv[20]).abs() <= 1.0,
+        "start {x0} vs valve {}",
+        data.mv[20]
+    );
+}
+
+#[test]
+fn a_valve_started_at_the_first_command_is_the_usual_simulation() {
+    let op: Vec<f64> = (0..400)
+        .map(|i| 50.0 + 3.0 * (i as f64 / 17.0).sin() + 0.4 * (i as f64 / 3.1).cos())
+        .collect();
+    for model in [
+        Model::Stenman(Stenman { d: 0.7 }),
+        ModelKind::He.build(&[0.8, 0.3]).unwrap(),
+    ] {
+        assert_eq!(model.simulate_from(&op, Some(op[0])), model.simulate(&op));
+        assert_eq!(model.simulate_from(&op, None), model.simulate(&op));
+        // started elsewhere, the valve stays there until the command leaves its band
+        let mv = model.simulate_from(&op, Some(op[0] + 0.5));
+        assert_eq!(mv[0], op[0] + 0.5);
+        assert_eq!(mv[1], op[0] + 0.5);
+    }
+}

@@ -203,14 +203,22 @@ impl Cells {
 }
 
 /// The cell of the Stenman partition that contains `d`: the range of d values whose valve
-/// trajectory driven by `op` is the same as d's, clipped to `[lo, hi)`. One pass over the data:
+/// trajectory driven by `op` from the valve position `x0` at the first sample is the same as d's,
+/// clipped to `[lo, hi)`. One pass over the data:
 /// the trajectory stays the same while every sticking step keeps `|u - x| <= d` and every slip
 /// keeps `|u - x| > d`. The trajectory itself is written to `mv`.
 // kept out of line: inlined into the walk, its loop variables were spilled to the stack
 #[inline(never)]
-pub fn stenman_cell_into(op: &[f64], d: f64, lo: f64, hi: f64, mv: &mut [f64]) -> (f64, f64) {
+pub fn stenman_cell_into(
+    op: &[f64],
+    x0: f64,
+    d: f64,
+    lo: f64,
+    hi: f64,
+    mv: &mut [f64],
+) -> (f64, f64) {
     let (mut a, mut b) = (lo, hi);
-    let mut x = op[0];
+    let mut x = x0;
     mv[0] = x;
     for (&u, m) in op[1..].iter().zip(&mut mv[1..]) {
         let delta = (u - x).abs();
@@ -226,9 +234,11 @@ pub fn stenman_cell_into(op: &[f64], d: f64, lo: f64, hi: f64, mv: &mut [f64]) -
 }
 
 /// Walk every cell of the Stenman partition of `[a, b)` (within the search range `[lo, hi)`) in
-/// order of d, handing each cell and its valve trajectory to `visit`.
+/// order of d, handing each cell and its valve trajectory to `visit`. The valve stands at `x0` at
+/// the first sample.
 pub fn stenman_walk(
     op: &[f64],
+    x0: f64,
     (a, b): (f64, f64),
     (lo, hi): (f64, f64),
     mv: &mut [f64],
@@ -236,7 +246,7 @@ pub fn stenman_walk(
 ) {
     let mut d = a;
     while d < b {
-        let (ca, cb) = stenman_cell_into(op, d, lo, hi, mv);
+        let (ca, cb) = stenman_cell_into(op, x0, d, lo, hi, mv);
         // the piece of the cell inside [a, b): cells that cross a chunk edge are visited in parts
         visit((ca.max(a), cb.min(b)), mv);
         if cb <= d {
