@@ -48,6 +48,10 @@ pub struct Columns {
     /// The process is integrating (a level loop): the indices use their integrating variants
     #[arg(long)]
     pub integrating: bool,
+    /// Closed-loop estimate: estimate where the valve stood at the first sample (as quantify
+    /// --estimate-start; about 3-4x the estimate's time)
+    #[arg(long)]
+    pub estimate_start: bool,
 }
 
 /// A loop record read from a file.
@@ -119,6 +123,7 @@ impl Columns {
         DiagnoseRequest {
             ts,
             integrating: self.integrating,
+            estimate_start: self.estimate_start,
             ..DiagnoseRequest::default()
         }
     }

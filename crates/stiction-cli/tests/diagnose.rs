@@ -68,6 +68,19 @@ fn a_sticky_loop_is_stiction_with_the_band_sized() {
     assert!(!text.contains("closed-loop check"), "{text}");
     let text = ok(&["diagnose", &f, "--sp", "sp"]);
     assert!(text.contains("closed-loop check: OP explains"), "{text}");
+    assert_eq!(v["quantification"]["valve_start_kind"], "first_op");
+    let v = json(&ok(&[
+        "diagnose",
+        &f,
+        "--sp",
+        "sp",
+        "--estimate-start",
+        "--json",
+    ]));
+    assert_eq!(
+        v["quantification"]["valve_start_kind"], "estimated",
+        "{v:#}"
+    );
 }
 
 #[test]

@@ -165,6 +165,9 @@ pub struct DiagnoseRequest {
     pub quantify: bool,
     /// Largest process delay the closed-loop estimate tries, samples.
     pub max_delay: usize,
+    /// The closed-loop estimate also estimates where the valve stood at the first sample
+    /// ([`QuantifyRequest::estimate_start`]).
+    pub estimate_start: bool,
     /// Margin of the weighted vote (in -1..=1) for a `stiction` or `no_stiction` verdict.
     pub verdict_margin: f64,
 }
@@ -180,6 +183,7 @@ impl Default for DiagnoseRequest {
             window: None,
             quantify: true,
             max_delay: 30,
+            estimate_start: false,
             verdict_margin: 0.3,
         }
     }
@@ -897,6 +901,7 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
         let mut q = QuantifyRequest::new(ModelKind::Stenman, Method::Exact);
         q.ts = req.ts;
         q.max_delay = req.max_delay;
+        q.estimate_start = req.estimate_start;
         q.integrating = req.integrating.then_some(true);
         // identification needs only the OP -> PV relation, which setpoint changes and manual
         // mode do not break (they excite it): the whole record is used unless its time axis has
