@@ -54,13 +54,14 @@ fn main() {
          Apparent stiction in OP units (% when OP is in %) and as a share of the OP's range in the record. \
          R² of the simulated PV (or its change, for an integrating fit). The labels are the contributor's comment \
          and the 20-loop test-set label of Damarla et al.; a stiction estimate is not a detection verdict: \
-         a loop without stiction can still fit a small band.\n"
+         a loop without stiction can still fit a small band. The last columns: the same with `--estimate-start` \
+         (where the valve stood at the first sample estimated instead of assumed at the first OP).\n"
     );
     let _ = writeln!(
         md,
-        "| loop | label (contributor) | test set | Ts (s) | samples | apparent stiction d | % of OP range | optimal d interval | linear model | R² sim | seconds |"
+        "| loop | label (contributor) | test set | Ts (s) | samples | apparent stiction d | % of OP range | optimal d interval | linear model | R² sim | seconds | estimated start: % of OP range, R² sim, seconds |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for name in LOOPS {
         let Some((h, rows)) = read_csv(&isdb.join("op_pv").join(format!("{name}.csv"))) else {
             let _ = writeln!(md, "| {name} | missing file |||||||||");
@@ -75,11 +76,24 @@ fn main() {
         let t = Instant::now();
         let q = quantify(&op, &pv, &req).expect("valid request");
         let secs = t.elapsed().as_secs_f64();
+        req.estimate_start = true;
+        let t = Instant::now();
+        let qe = quantify(&op, &pv, &req).expect("valid request");
+        let secs_e = t.elapsed().as_secs_f64();
+        let estimated = if qe.status == "ok" {
+            format!(
+                "{:.1}, {:.3}, {secs_e:.2}",
+                qe.apparent_stiction_pct_of_op_range.unwrap_or(f64::NAN),
+                qe.fit.as_ref().map_or(f64::NAN, |f| f.r2_simulation)
+            )
+        } else {
+            "insufficient data".into()
+        };
         let row = if q.status == "ok" {
             let lm = q.linear_model.as_ref().expect("ok has a model");
             let [a, b] = q.interval["d"];
             format!(
-                "| {name} | {} | {} | {ts} | {} | {:.3} | {:.1} | [{a:.3}, {b:.3}] | {} na={} nb={} delay={} | {:.3} | {secs:.2} |",
+                "| {name} | {} | {} | {ts} | {} | {:.3} | {:.1} | [{a:.3}, {b:.3}] | {} na={} nb={} delay={} | {:.3} | {secs:.2} | {estimated} |",
                 label[idx("isdb_comment_label")],
                 label[idx("damarla20")],
                 q.samples,
@@ -93,7 +107,7 @@ fn main() {
             )
         } else {
             format!(
-                "| {name} | {} | {} | {ts} | {} | insufficient data: {} |||||{secs:.2} |",
+                "| {name} | {} | {} | {ts} | {} | insufficient data: {} |||||{secs:.2} | {estimated} |",
                 label[idx("isdb_comment_label")],
                 label[idx("damarla20")],
                 q.samples,
