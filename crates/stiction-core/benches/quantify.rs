@@ -24,6 +24,12 @@ fn benches(c: &mut Criterion) {
         g.bench_function(format!("stenman_exact_{n}"), |b| {
             b.iter(|| quantify(black_box(&op), black_box(&pv), &req).unwrap())
         });
+        // with the valve's start estimated (the record cut 23 samples in, so it matters)
+        let mut start = req.clone();
+        start.estimate_start = true;
+        g.bench_function(format!("stenman_exact_estimate_start_{n}"), |b| {
+            b.iter(|| quantify(black_box(&op[23..]), black_box(&pv[23..]), &start).unwrap())
+        });
         // the baseline: every cell of the whole record
         let mut full = req.clone();
         full.staged = false;
