@@ -316,7 +316,7 @@ pub fn quantify(
     let estimate_start = req.estimate_start && req.valve_start.is_none();
     // the first samples: at least a few oscillation periods (too short a start ranks the
     // cells by the transient)
-    let m = if n >= STAGE_FROM {
+    let m = if n >= STAGE_FROM && (staged || estimate_start) {
         let period = crate::detect::regularity(pv, 1.0).period.unwrap_or(0.0);
         STAGE_SAMPLES
             .max((STAGE_PERIODS * period) as usize)
