@@ -745,13 +745,35 @@ fn estimates(h: &mut String, d: &Diagnosis, q: Option<&Quantification>) {
     let ellipse = a
         .and_then(|a| a.ellipse)
         .map_or("not computed".into(), |v| format!("{} OP units", num(v)));
-    kv(
-        h,
-        &[
-            ("Closed-loop estimate (Stenman d)", closed),
-            ("Ellipse fit of the PV-OP plot (Choudhury et al.)", ellipse),
-        ],
-    );
+    let mut rows = vec![
+        ("Closed-loop estimate (Stenman d)", closed),
+        ("Ellipse fit of the PV-OP plot (Choudhury et al.)", ellipse),
+    ];
+    if let Some(c) = &d.closed_loop_check {
+        rows.push((
+            "Closed-loop check: does OP drive the oscillation?",
+            format!(
+                "OP explains {} % of the PV's variation above its noise ({} without stiction); at least {} % expected: <strong>{}</strong>",
+                num(100.0 * c.explained.max(0.0)),
+                c.explained_without_stiction
+                    .map_or("–".into(), |w| format!("{} %", num(100.0 * w.max(0.0)))),
+                num(100.0 * c.limit),
+                if c.passed { "passed" } else { "failed: the oscillation enters the loop elsewhere" }
+            ),
+        ));
+    }
+    if let Some(x0) = q.and_then(|q| q.valve_start) {
+        let how = match q.and_then(|q| q.valve_start_kind.as_deref()) {
+            Some("estimated") => "estimated (<code>--estimate-start</code>)",
+            Some("given") => "given",
+            _ => "assumed at the first OP (<code>--estimate-start</code> estimates it)",
+        };
+        rows.push((
+            "Valve position at the first sample",
+            format!("{}, {how}", num(x0)),
+        ));
+    }
+    kv(h, &rows);
     if let Some(q) = q {
         if !q.interval.is_empty() && q.interval_kind.starts_with("exact") {
             h.push_str(

@@ -103,6 +103,9 @@ fn report_of_a_sticky_loop_is_self_contained() {
     }
     // the estimate, the model overlay, the estimator and the caveat
     assert!(html.contains("Closed-loop estimate (Stenman d)"));
+    assert!(html.contains("Closed-loop check: does OP drive the oscillation?"));
+    assert!(html.contains("<strong>passed</strong>"));
+    assert!(html.contains("Valve position at the first sample"));
     assert!(html.contains("optimal set"));
     assert!(html.contains("estimated MV"));
     assert!(html.contains("PV simulated"));
