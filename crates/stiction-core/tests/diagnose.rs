@@ -23,6 +23,22 @@ fn record(l: &LoopData) -> LoopRecord<'_> {
     }
 }
 
+/// A healthy valve on FOPTD (K, tau, delay) under PI (Kc, Ti), with a sine of amplitude 1 and
+/// period 150 s added to the PV.
+fn disturbed((k, tau, delay): (f64, f64, f64), (kc, ti): (f64, f64), noise: f64) -> LoopData {
+    run(0.0, |cl| {
+        cl.process = Process::Foptd { k, tau, delay };
+        cl.pi.kc = kc;
+        cl.pi.ti = ti;
+        cl.noise = noise;
+        cl.disturbance = Some(Signal::Sine {
+            amplitude: 1.0,
+            period: 150.0,
+            offset: 0.0,
+        });
+    })
+}
+
 fn quick() -> DiagnoseRequest {
     DiagnoseRequest {
         quantify: false,
@@ -47,20 +63,7 @@ fn sticky_healthy_and_disturbed_loops() {
     assert_eq!(d.verdict, Verdict::NoStiction, "{:#?}", d.evidence);
 
     // an external sinusoidal disturbance through a healthy valve: oscillates, not stiction
-    let disturbed = run(0.0, |cl| {
-        cl.process = Process::Foptd {
-            k: 1.0,
-            tau: 30.0,
-            delay: 5.0,
-        };
-        cl.pi.kc = 1.0;
-        cl.pi.ti = 30.0;
-        cl.disturbance = Some(Signal::Sine {
-            amplitude: 1.0,
-            period: 150.0,
-            offset: 0.0,
-        });
-    });
+    let disturbed = disturbed((1.0, 30.0, 5.0), (1.0, 30.0), 0.05);
     let d = diagnose(&record(&disturbed), &quick()).unwrap();
     assert!(d.oscillation.as_ref().unwrap().oscillating);
     assert_ne!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
@@ -187,21 +190,7 @@ fn a_sinusoidal_oscillation_is_linear_whatever_its_phase() {
     // a slow disturbance against an integral-dominated controller puts OP about 90 degrees
     // behind PV, which Horch's cross-correlation reads as stiction; OP and PV are sinusoids,
     // which the harmonics index reads as a linear oscillation
-    let disturbed = run(0.0, |cl| {
-        cl.process = Process::Foptd {
-            k: 3.0,
-            tau: 10.0,
-            delay: 10.0,
-        };
-        cl.pi.kc = 0.2;
-        cl.pi.ti = 10.0;
-        cl.noise = 0.02;
-        cl.disturbance = Some(Signal::Sine {
-            amplitude: 1.0,
-            period: 150.0,
-            offset: 0.0,
-        });
-    });
+    let disturbed = disturbed((3.0, 10.0, 10.0), (0.2, 10.0), 0.02);
     let d = diagnose(&record(&disturbed), &quick()).unwrap();
     let vote = |name: &str| d.indices.iter().find(|i| i.name == name).unwrap().vote;
     assert_eq!(vote("harmonics"), Vote::NoStiction, "{:#?}", d.indices);
