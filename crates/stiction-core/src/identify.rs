@@ -153,6 +153,18 @@ pub struct Fit {
 }
 
 impl Fit {
+    /// Whether the fitted A(q) is stable (every pole inside the unit circle): an unstable fit's
+    /// simulation runs away, and its R² says nothing but that.
+    pub fn stable(&self) -> bool {
+        match *self.a.as_slice() {
+            [] => true,
+            [a1] => a1.abs() < 1.0,
+            // z^2 - a1 z - a2 (the Jury conditions)
+            [a1, a2] => a2.abs() < 1.0 && a1.abs() < 1.0 - a2,
+            _ => false,
+        }
+    }
+
     pub fn r2_one_step(&self) -> f64 {
         1.0 - self.sse_one_step / self.sst
     }

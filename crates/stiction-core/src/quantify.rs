@@ -113,7 +113,8 @@ pub struct FitQuality {
     pub r2_one_step: f64,
     pub sse_simulation: f64,
     /// R² in simulation of the best linear model of the same family with a valve that follows
-    /// OP exactly (no stiction): how much of the fit the stiction model itself earns.
+    /// OP exactly (no stiction): how much of the fit the stiction model itself earns. `None` when
+    /// no stable linear model fits that valve (its simulation would run away).
     pub r2_simulation_without_stiction: Option<f64>,
 }
 
@@ -696,9 +697,15 @@ fn quantify_inner(
         let mut same = search.clone();
         same.integrating = structure.integrating;
         same.self_regulating = !structure.integrating;
-        let chosen = problem.prepared.fit(&mv0).map(|f| f.r2_simulation());
+        // an unstable fit's simulation runs away: no answer rather than an R² of -1e50
+        let chosen = problem
+            .prepared
+            .fit(&mv0)
+            .filter(Fit::stable)
+            .map(|f| f.r2_simulation());
         let reselected = identify::select(&data, &mv0, &same)
             .and_then(|sel| identify::fit(&data, &mv0, sel.structure))
+            .filter(Fit::stable)
             .map(|f| f.r2_simulation());
         match (chosen, reselected) {
             (Some(a), Some(b)) => Some(a.max(b)),

@@ -198,3 +198,53 @@ fn a_valve_started_at_the_first_command_is_the_usual_simulation() {
         assert_eq!(mv[1], op[0] + 0.5);
     }
 }
+
+#[test]
+fn an_unstable_linear_fit_gives_no_r2_without_stiction() {
+    let fit = |a: &[f64]| identify::Fit {
+        structure: Structure {
+            integrating: false,
+            na: a.len(),
+            nb: 1,
+            nk: 1,
+        },
+        a: a.to_vec(),
+        b: vec![1.0],
+        c: 0.0,
+        sse_one_step: 0.0,
+        sse_simulation: 0.0,
+        sst: 1.0,
+    };
+    assert!(fit(&[0.5]).stable() && !fit(&[1.2]).stable());
+    // poles 0.8 and 0.7; then 1 and 0.5; then a complex pair of modulus 0.9
+    assert!(fit(&[1.5, -0.56]).stable());
+    assert!(!fit(&[1.5, -0.5]).stable());
+    assert!(fit(&[0.0, -0.81]).stable() && !fit(&[0.0, -1.21]).stable());
+
+    // a slow sticky loop whose linear fit without stiction runs away in simulation: no number
+    // rather than an R² of about -1e56
+    let mut cl = ClosedLoop::new(Model::Stenman(Stenman { d: 2.0 }));
+    cl.process = stiction_core::sim::Process::Foptd {
+        k: 1.0,
+        tau: 30.0,
+        delay: 5.0,
+    };
+    cl.pi = stiction_core::sim::Pi { kc: 1.0, ti: 30.0 };
+    cl.samples = 2000;
+    cl.noise = 0.02;
+    cl.seed = 2;
+    let data = cl.run().unwrap();
+    let q = quantify(
+        &data.op,
+        &data.pv,
+        &QuantifyRequest::new(ModelKind::Stenman, Method::Exact),
+    )
+    .unwrap();
+    let f = q.fit.unwrap();
+    assert!(f.r2_simulation > 0.9);
+    assert!(
+        f.r2_simulation_without_stiction.is_none_or(|r2| r2 > -10.0),
+        "{:?}",
+        f.r2_simulation_without_stiction
+    );
+}
