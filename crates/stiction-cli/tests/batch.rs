@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
 mod common;
-use common::{fails, ok, stiction};
+use common::{closed_stenman, fails, ok, stiction};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -13,23 +13,7 @@ fn s(p: &Path) -> &str {
 
 /// A closed loop of 1500 samples with Stenman stiction `d` (0: a healthy valve).
 fn simulate(path: &Path, d: &str, seed: &str) {
-    ok(&[
-        "simulate",
-        "--loop",
-        "closed",
-        "--model",
-        "stenman",
-        "--param",
-        &format!("d={d}"),
-        "--samples",
-        "1500",
-        "--noise",
-        "0.05",
-        "--seed",
-        seed,
-        "-o",
-        s(path),
-    ]);
+    closed_stenman(path, d, &["--noise", "0.05", "--seed", seed]);
 }
 
 /// A folder with a sticky loop, a healthy loop and a file with a text cell in the op column.

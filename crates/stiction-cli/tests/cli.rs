@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{fails, json, ok};
+use common::{closed_stenman, fails, json, ok};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
@@ -446,25 +446,8 @@ fn bad_bounds_and_names() {
 
 fn closed_loop(dir: &Path, d: &str) -> String {
     let p = dir.join("loop.csv");
-    let f = p.to_str().unwrap();
-    ok(&[
-        "simulate",
-        "--loop",
-        "closed",
-        "--model",
-        "stenman",
-        "--param",
-        &format!("d={d}"),
-        "--samples",
-        "1500",
-        "--noise",
-        "0.02",
-        "--seed",
-        "4",
-        "-o",
-        f,
-    ]);
-    f.to_string()
+    closed_stenman(&p, d, &["--noise", "0.02", "--seed", "4"]);
+    p.to_str().unwrap().to_string()
 }
 
 #[test]

@@ -3,30 +3,17 @@
 use std::path::Path;
 
 mod common;
-use common::{fails, json, ok};
+use common::{closed_stenman, fails, json, ok};
 
 /// A closed loop (default process K = 3, tau = 10 s, delay = 10 s, PI 0.2 / 10 s).
 fn simulate(dir: &Path, name: &str, d: &str, extra: &[&str]) -> String {
     let p = dir.join(name);
-    let f = p.to_str().unwrap().to_string();
-    let mut args = vec![
-        "simulate", "--loop", "closed", "--model", "stenman", "--param",
-    ];
-    let param = format!("d={d}");
-    args.push(&param);
-    args.extend_from_slice(&[
-        "--samples",
-        "1500",
-        "--noise",
-        "0.05",
-        "--seed",
-        "3",
-        "-o",
-        &f,
-    ]);
-    args.extend_from_slice(extra);
-    ok(&args);
-    f
+    closed_stenman(
+        &p,
+        d,
+        &[&["--noise", "0.05", "--seed", "3"], extra].concat(),
+    );
+    p.to_str().unwrap().to_string()
 }
 
 fn rows(path: &str) -> Vec<Vec<String>> {

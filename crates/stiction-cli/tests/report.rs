@@ -6,7 +6,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
-use common::{ok, stiction};
+use common::{closed_stenman, ok, stiction};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -15,19 +15,7 @@ fn s(p: &Path) -> &str {
 /// A closed loop with a sticky valve (Stenman d = 2): the report says stiction.
 fn sticky_loop(dir: &Path) -> PathBuf {
     let csv = dir.join("loop.csv");
-    ok(&[
-        "simulate",
-        "--loop",
-        "closed",
-        "--model",
-        "stenman",
-        "--param",
-        "d=2",
-        "--samples",
-        "1500",
-        "-o",
-        s(&csv),
-    ]);
+    closed_stenman(&csv, "2", &[]);
     csv
 }
 

@@ -837,15 +837,16 @@ pub const MIN_EXPLAINED_BY_OP: f64 = 0.3;
 /// its change per sample for an integrating fit). `None` when the output has no variance above
 /// the noise.
 fn signal_explained(pv: &[f64], output: &str, r2: f64) -> Option<f64> {
+    let variance = |x: &[f64]| {
+        let m = mean(x);
+        x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / x.len().max(1) as f64
+    };
+    let noise_var = noise_std(pv).powi(2);
     let (var, noise_var) = if output == "delta_pv" {
         let d: Vec<f64> = pv.windows(2).map(|w| w[1] - w[0]).collect();
-        let m = mean(&d);
-        let v = d.iter().map(|x| (x - m).powi(2)).sum::<f64>() / d.len().max(1) as f64;
-        (v, 2.0 * noise_std(pv).powi(2))
+        (variance(&d), 2.0 * noise_var)
     } else {
-        let m = mean(pv);
-        let v = pv.iter().map(|x| (x - m).powi(2)).sum::<f64>() / pv.len().max(1) as f64;
-        (v, noise_std(pv).powi(2))
+        (variance(pv), noise_var)
     };
     if var.is_nan() || var <= 0.0 || !r2.is_finite() {
         return None;

@@ -1,6 +1,7 @@
 //! What every CLI test does: spawn the binary as a user would and read what it says.
 #![allow(dead_code)] // each test file uses some of these
 
+use std::path::Path;
 use std::process::{Command, Output};
 
 pub fn stiction(args: &[&str]) -> Output {
@@ -39,4 +40,25 @@ pub fn fails(args: &[&str], needles: &[&str]) {
 
 pub fn json(text: &str) -> serde_json::Value {
     serde_json::from_str(text).expect("valid JSON")
+}
+
+/// `stiction simulate` of a closed loop of 1500 samples with a Stenman valve of band `d` (0: a
+/// healthy valve) into `path`; `extra` adds or overrides options (noise, seed, process).
+pub fn closed_stenman(path: &Path, d: &str, extra: &[&str]) {
+    let param = format!("d={d}");
+    let mut args = vec![
+        "simulate",
+        "--loop",
+        "closed",
+        "--model",
+        "stenman",
+        "--param",
+        &param,
+        "--samples",
+        "1500",
+        "-o",
+        path.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    ok(&args);
 }
