@@ -1,0 +1,261 @@
+//! The table every reader produces: header names and rows of cells as text, with the line or
+//! row each came from, so every message can name the file, the column and the row.
+
+use super::missing::is_missing;
+use super::time::{self, TimeAxis, TimeError, TimeSpec};
+use super::ReadOptions;
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+
+/// A data file read as text: header names and rows of cells.
+pub struct Table {
+    pub path: PathBuf,
+    pub headers: Vec<String>,
+    /// Every cell's trimmed text, one after the other (one allocation for the whole file) ...
+    text: String,
+    /// ... and where each is: row after row, each row as long as the header (missing trailing
+    /// cells are empty).
+    spans: Vec<(usize, usize)>,
+    /// Line (text files) or row (sheets, Parquet) number of each row; the header is 1 in a
+    /// text file.
+    lines: Vec<u64>,
+    /// What a row is called in messages: "line" or "row".
+    row_word: &'static str,
+    /// The sheet read from a workbook ...
+    pub sheet: Option<String>,
+    /// ... and every sheet it has.
+    pub sheets: Vec<String>,
+}
+
+impl Table {
+    /// An empty table with these headers; rows are added with [`Table::push_row`].
+    pub(super) fn new(path: &Path, headers: Vec<String>) -> Table {
+        Table {
+            path: path.to_path_buf(),
+            headers,
+            text: String::new(),
+            spans: Vec::new(),
+            lines: Vec::new(),
+            row_word: "line",
+            sheet: None,
+            sheets: Vec::new(),
+        }
+    }
+
+    /// Messages call rows "row N" (sheets, Parquet) instead of "line N".
+    pub(super) fn rows_are_rows(mut self) -> Table {
+        self.row_word = "row";
+        self
+    }
+
+    /// Add one row (at most as many cells as headers; missing trailing cells are empty). A row
+    /// of empty cells is skipped.
+    pub(super) fn push_row<'a>(&mut self, cells: impl IntoIterator<Item = &'a str>, line: u64) {
+        let start = self.spans.len();
+        let mut any = false;
+        for c in cells.into_iter().take(self.headers.len()) {
+            let c = c.trim();
+            any |= !c.is_empty();
+            let a = self.text.len();
+            self.text.push_str(c);
+            self.spans.push((a, self.text.len()));
+        }
+        if !any {
+            self.spans.truncate(start);
+            return;
+        }
+        self.spans.resize(start + self.headers.len(), (0, 0));
+        self.lines.push(line);
+    }
+
+    /// Read a file (`-`: standard input) in any format this tool reads, found from its bytes,
+    /// with a sheet of a workbook chosen.
+    pub fn read_with(path: &Path, opts: &ReadOptions) -> Result<Table> {
+        if path.as_os_str() == "-" {
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut std::io::stdin(), &mut bytes)
+                .context("standard input cannot be read")?;
+            return Self::parse_with(Path::new("<stdin>"), &bytes, opts);
+        }
+        match std::fs::read(path) {
+            Ok(bytes) => Self::parse_with(path, &bytes, opts),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                bail!("{}: no such file; check the path", path.display())
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::IsADirectory || path.is_dir() => bail!(
+                "{}: is a folder; give a data file (batch takes folders)",
+                path.display()
+            ),
+            Err(e) => bail!("{}: cannot be read: {e}", path.display()),
+        }
+    }
+
+    /// A table from a file's bytes already in memory (CSV text, gzip, a workbook, Parquet);
+    /// `path` names it in messages.
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Table> {
+        Self::parse_with(path, bytes, &ReadOptions::default())
+    }
+
+    /// As [`Table::parse`], with a sheet of a workbook chosen.
+    pub fn parse_with(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Table> {
+        super::format::parse(path, bytes, opts, 0)
+    }
+
+    pub fn len(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// The error for a table without data rows; a workbook's names its sheets.
+    pub fn no_rows(&self) -> anyhow::Error {
+        let file = self.path.display();
+        match &self.sheet {
+            Some(sheet) if self.sheets.len() > 1 => anyhow::anyhow!(
+                "{file}: sheet '{sheet}' has no data rows; the sheets are {}: choose one with --sheet NAME",
+                self.sheets
+                    .iter()
+                    .map(|n| format!("'{n}'"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            _ => anyhow::anyhow!("{file}: the file has a header but no data rows"),
+        }
+    }
+
+    /// Index of a column by name, case-insensitive.
+    pub fn find(&self, name: &str) -> Option<usize> {
+        self.headers
+            .iter()
+            .position(|h| h.eq_ignore_ascii_case(name.trim()))
+    }
+
+    /// The column `name`, or an error naming the flag that chooses it.
+    pub fn require(&self, name: &str, flag: &str, role: &str) -> Result<usize> {
+        self.find(name).with_context(|| {
+            format!(
+                "{}: no column '{name}' for the {role}; the columns are {}. Name the right one with {flag} COLUMN",
+                self.path.display(),
+                self.headers.join(", ")
+            )
+        })
+    }
+
+    /// The trimmed text of a cell.
+    pub fn cell(&self, row: usize, col: usize) -> &str {
+        let (a, b) = self.spans[row * self.headers.len() + col];
+        &self.text[a..b]
+    }
+
+    /// Where row `row` is, in words: "line 12" or "row 12".
+    pub fn at(&self, row: usize) -> String {
+        format!("{} {}", self.row_word, self.lines[row])
+    }
+
+    /// The line or row number of row `row` in the file.
+    pub fn line(&self, row: usize) -> u64 {
+        self.lines[row]
+    }
+
+    /// Parse a column as numbers: NaN where a cell is missing (blank, NaN, #N/A, a historian
+    /// state such as Bad Input); an error for any other text.
+    pub fn numbers(&self, col: usize) -> Result<Vec<f64>> {
+        let name = &self.headers[col];
+        let file = self.path.display();
+        let mut out = Vec::with_capacity(self.len());
+        for i in 0..self.len() {
+            let cell = self.cell(i, col);
+            if is_missing(cell) {
+                out.push(f64::NAN);
+                continue;
+            }
+            // a decimal comma (European historian exports, semicolon separated) reads as a point
+            let v = super::parse_number(cell).with_context(|| {
+                format!(
+                    "{file}: {}, column '{name}': '{}' is not a number; use plain decimal numbers such as 12.5 \
+                     (blank cells, NaN, #N/A and historian states such as Bad Input are read as gaps)",
+                    self.at(i),
+                    shown(cell)
+                )
+            })?;
+            if !v.is_finite() {
+                bail!(
+                    "{file}: {}, column '{name}' is {cell}; a value must be a finite number: fill the cell or leave it blank (a gap)",
+                    self.at(i)
+                );
+            }
+            out.push(v);
+        }
+        Ok(out)
+    }
+
+    /// How many cells of a column are missing values.
+    pub fn missing(&self, col: usize) -> usize {
+        (0..self.len())
+            .filter(|&i| is_missing(self.cell(i, col)))
+            .count()
+    }
+
+    /// Parse a mode column as `true` where the loop is in automatic: auto / manual (also AUT, MAN,
+    /// cascade, CAS), 1 / 0, true / false, on / off. A missing cell is not automatic.
+    pub fn modes(&self, col: usize) -> Result<Vec<bool>> {
+        let name = &self.headers[col];
+        let file = self.path.display();
+        let mut out = Vec::with_capacity(self.len());
+        for i in 0..self.len() {
+            let cell = self.cell(i, col);
+            let auto = match cell.to_ascii_lowercase().as_str() {
+                "auto" | "automatic" | "aut" | "a" | "1" | "true" | "on" | "cascade" | "cas" => true,
+                "manual" | "man" | "m" | "0" | "false" | "off" => false,
+                _ if is_missing(cell) => false,
+                _ => bail!(
+                    "{file}: {}, column '{name}': '{}' is not a controller mode; use auto or manual (also 1 or 0)",
+                    self.at(i),
+                    shown(cell)
+                ),
+            };
+            out.push(auto);
+        }
+        Ok(out)
+    }
+
+    /// Parse a time column as seconds (text timestamps: since 1970), in any form
+    /// [`TimeSpec`]'s default reads; NaN where a cell is missing.
+    #[allow(dead_code)] // part of the reading API the commands share; loops read time_axis
+    pub fn times(&self, col: usize) -> Result<Vec<f64>> {
+        Ok(self.time_axis(col, &TimeSpec::default())?.seconds)
+    }
+
+    /// Parse a time column in the given form and zone: the seconds, the count of missing cells
+    /// and what the reader noticed (epoch milliseconds, a daylight-saving repeat).
+    pub fn time_axis(&self, col: usize, spec: &TimeSpec) -> Result<TimeAxis> {
+        let cells: Vec<&str> = (0..self.len()).map(|i| self.cell(i, col)).collect();
+        let name = &self.headers[col];
+        let file = self.path.display();
+        time::parse_column(&cells, &|c: &str| is_missing(c), spec).map_err(|e| match e {
+            TimeError::Cell { row, expected } => anyhow::anyhow!(
+                "{file}: {}, column '{name}': '{}' is not {expected}",
+                self.at(row),
+                shown(cells[row])
+            ),
+            TimeError::Repeat { row, back } => {
+                let before = (0..row).rev().find(|&r| !is_missing(cells[r])).unwrap_or(0);
+                anyhow::anyhow!(
+                    "{file}: {}, column '{name}': the local time steps back by {:.0} minutes ('{}' then '{}'), as when daylight saving ends; \
+                     give the zone of the times with --tz ZONE (e.g. --tz Europe/Berlin)",
+                    self.at(row),
+                    back / 60.0,
+                    shown(cells[before]),
+                    shown(cells[row])
+                )
+            }
+        })
+    }
+}
+
+/// A cell's text as shown in a message: at most 40 characters.
+fn shown(cell: &str) -> String {
+    let mut s: String = cell.chars().take(40).collect();
+    if s.len() < cell.len() {
+        s.push_str("...");
+    }
+    s
+}

@@ -1,0 +1,424 @@
+//! A loop record read from a file: the column flags shared by diagnose, report and batch
+//! ([`Columns`]), how to read the file ([`Reading`]: sheet, time format, zone), and the record
+//! itself ([`LoopFile`]) with its gaps as NaN, its rows in time order and notes on what the
+//! reader decided.
+
+use crate::data::{self, ReadOptions, Table, TimeFormat, TimeSpec};
+use crate::words::count;
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+use stiction_core::diagnose::{DiagnoseRequest, LoopRecord};
+
+/// How to read a data file beyond its columns: the sheet of a workbook, the form and the zone
+/// of its times.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct Reading {
+    /// Sheet of a workbook (xlsx, xls, ods) to read [default: the first]
+    #[arg(long, value_name = "NAME")]
+    pub sheet: Option<String>,
+    /// Form of the time column: a strftime pattern such as '%d.%m.%Y %H:%M:%S', or seconds,
+    /// epoch-ms, excel (serial days) [default: auto: numbers are seconds (milliseconds past
+    /// 1e11), text is ISO 8601, DD.MM.YYYY, MM/DD/YYYY hh:mm:ss AM and other common forms]
+    #[arg(long, value_name = "FMT", value_parser = check_time_format)]
+    pub time_format: Option<String>,
+    /// Time zone of local times without a zone in the text: an IANA name (Europe/Berlin), UTC
+    /// or an offset (+01:00); needed where daylight saving changes [default: read as UTC]
+    #[arg(long, value_name = "ZONE", value_parser = check_zone)]
+    pub tz: Option<String>,
+}
+
+fn check_time_format(s: &str) -> Result<String, String> {
+    s.parse::<TimeFormat>().map(|_| s.to_string())
+}
+
+fn check_zone(s: &str) -> Result<String, String> {
+    data::time::zone(s).map(|_| s.to_string())
+}
+
+impl Reading {
+    pub fn options(&self) -> ReadOptions {
+        ReadOptions {
+            sheet: self.sheet.clone(),
+        }
+    }
+
+    /// Read a data file (or `-`, standard input) with these options.
+    pub fn open(&self, path: &Path) -> Result<Table> {
+        Table::read_with(path, &self.options())
+    }
+
+    /// The form and zone of the time column.
+    pub fn time_spec(&self) -> Result<TimeSpec> {
+        let format = match &self.time_format {
+            Some(f) => f
+                .parse()
+                .map_err(|e| anyhow::anyhow!("--time-format: {e}"))?,
+            None => TimeFormat::Auto,
+        };
+        let tz = self
+            .tz
+            .as_deref()
+            .map(data::time::zone)
+            .transpose()
+            .map_err(|e| anyhow::anyhow!(e))?;
+        Ok(TimeSpec { format, tz })
+    }
+}
+
+/// The columns of a loop record and how to read them (shared by diagnose, report and batch).
+#[derive(clap::Args, Clone)]
+pub struct Columns {
+    /// Column of the controller output
+    #[arg(long, default_value = "op")]
+    pub op: String,
+    /// Column of the process variable
+    #[arg(long, default_value = "pv")]
+    pub pv: String,
+    /// Column of the setpoint [default: none; the error is then PV's deviation from its mean]
+    #[arg(long)]
+    pub sp: Option<String>,
+    /// Column of the controller mode (auto/manual or 1/0); only automatic stretches are judged
+    #[arg(long)]
+    pub mode: Option<String>,
+    /// Column of the valve position, when recorded: direct evidence that outweighs the rest
+    #[arg(long)]
+    pub mv: Option<String>,
+    /// OP values of a closed and a fully open valve, LO:HI (e.g. 0:1 or -1:1); the band is
+    /// reported in % of this span [default: 0:100, OP in %]
+    #[arg(long, value_name = "LO:HI", value_parser = parse_op_range)]
+    pub op_range: Option<[f64; 2]>,
+    /// Column of time (seconds, or dates such as 2024-03-01 12:00:05) [default: t, time or timestamp if present]
+    #[arg(long)]
+    pub time: Option<String>,
+    /// Sampling time in seconds [default: the median step of the time column, else 1]
+    #[arg(long)]
+    pub ts: Option<f64>,
+    /// The process is integrating (a level loop): the indices use their integrating variants
+    #[arg(long)]
+    pub integrating: bool,
+    /// Closed-loop estimate: estimate where the valve stood at the first sample (as quantify
+    /// --estimate-start; about 3-4x the estimate's time)
+    #[arg(long)]
+    pub estimate_start: bool,
+    #[command(flatten)]
+    pub reading: Reading,
+}
+
+/// A loop record read from a file. Gaps (missing cells) are NaN in op, pv and sp, and not
+/// automatic in `auto`; rows are in time order.
+pub struct LoopFile {
+    pub op: Vec<f64>,
+    pub pv: Vec<f64>,
+    pub sp: Option<Vec<f64>>,
+    pub mv: Option<Vec<f64>>,
+    pub time: Option<Vec<f64>>,
+    pub auto: Option<Vec<bool>>,
+    pub ts: f64,
+    /// Cells treated as missing, per column (name, count), columns without any left out.
+    pub missing: Vec<(String, usize)>,
+    /// What the reader decided that a person should know (time order, time form, zone).
+    pub notes: Vec<String>,
+    /// The table row of each sample, when the rows were sorted by time (else sample k is row k).
+    pub rows: Option<Vec<usize>>,
+}
+
+impl LoopFile {
+    pub fn record(&self) -> LoopRecord<'_> {
+        LoopRecord {
+            op: &self.op,
+            pv: &self.pv,
+            sp: self.sp.as_deref(),
+            mv: self.mv.as_deref(),
+            time: self.time.as_deref(),
+            auto: self.auto.as_deref(),
+        }
+    }
+
+    /// The table row of sample `k`.
+    pub fn row_of(&self, k: usize) -> usize {
+        self.rows.as_ref().map_or(k, |r| r[k])
+    }
+
+    /// All cells treated as missing.
+    pub fn missing_total(&self) -> usize {
+        self.missing.iter().map(|(_, k)| k).sum()
+    }
+
+    /// One sentence on the missing cells, if any (for diagnose, report and batch).
+    pub fn missing_note(&self) -> Option<String> {
+        let total = self.missing_total();
+        (total > 0).then(|| {
+            let which: Vec<String> = self
+                .missing
+                .iter()
+                .map(|(name, k)| format!("{name} {k}"))
+                .collect();
+            format!(
+                "{} treated as missing ({}: blank, NaN, #N/A or a historian state such as Bad Input); they are gaps in the record",
+                count(total, "cell", "cells"),
+                which.join(", ")
+            )
+        })
+    }
+}
+
+/// Which columns make a loop record: (column name, flag, role) of each signal.
+pub struct Signals<'a> {
+    pub op: &'a str,
+    pub pv: &'a str,
+    pub sp: Option<&'a str>,
+    pub mv: Option<&'a str>,
+    pub mode: Option<&'a str>,
+    pub time: Option<&'a str>,
+    pub ts: Option<f64>,
+}
+
+impl Columns {
+    /// Read the file these columns come from (with `--sheet`).
+    pub fn open(&self, path: &Path) -> Result<Table> {
+        self.reading.open(path)
+    }
+
+    pub fn read(&self, table: &Table) -> Result<LoopFile> {
+        if let (Some(want), Some(got)) = (&self.reading.sheet, &table.sheet) {
+            if !want.trim().eq_ignore_ascii_case(got) {
+                bail!(
+                    "{}: sheet '{got}' was read, not '{want}' as --sheet asks (a bug: please report it)",
+                    table.path.display()
+                );
+            }
+        }
+        let signals = Signals {
+            op: &self.op,
+            pv: &self.pv,
+            sp: self.sp.as_deref(),
+            mv: self.mv.as_deref(),
+            mode: self.mode.as_deref(),
+            time: self.time.as_deref(),
+            ts: self.ts,
+        };
+        read_loop(table, &signals, &self.reading.time_spec()?)
+    }
+
+    pub fn request(&self, ts: f64) -> DiagnoseRequest {
+        DiagnoseRequest {
+            ts,
+            integrating: self.integrating,
+            estimate_start: self.estimate_start,
+            op_range: self.op_range.unwrap_or([0.0, 100.0]),
+            ..DiagnoseRequest::default()
+        }
+    }
+}
+
+/// `LO:HI` with LO < HI.
+fn parse_op_range(text: &str) -> Result<[f64; 2], String> {
+    let (lo, hi) = text
+        .split_once(':')
+        .ok_or_else(|| format!("'{text}' is not LO:HI (e.g. 0:100, 0:1 or -1:1)"))?;
+    let num = |s: &str| {
+        s.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{s}' in '{text}' is not a number"))
+    };
+    let (lo, hi) = (num(lo)?, num(hi)?);
+    if hi <= lo {
+        return Err(format!(
+            "'{text}': the value of a fully open valve ({hi}) must exceed that of a closed one ({lo})"
+        ));
+    }
+    Ok([lo, hi])
+}
+
+/// Read a loop record: numbers with gaps as NaN, the time axis in the given form and zone
+/// (missing times filled in between their neighbours, their rows gaps), rows sorted by time.
+pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile> {
+    if let Some(ts) = s.ts {
+        if !(ts > 0.0 && ts.is_finite()) {
+            bail!("--ts {ts}: the sampling time must be a positive number of seconds");
+        }
+    }
+    let file = table.path.display();
+    if table.len() == 0 {
+        return Err(table.no_rows());
+    }
+    let mut missing = Vec::new();
+    let mut column = |name: &str, flag: &str, role: &str| -> Result<Vec<f64>> {
+        let c = table.require(name, flag, role)?;
+        let v = table.numbers(c)?;
+        let k = v.iter().filter(|x| x.is_nan()).count();
+        if k > 0 {
+            missing.push((table.headers[c].clone(), k));
+        }
+        Ok(v)
+    };
+    let mut op = column(s.op, "--op", "controller output op")?;
+    let mut pv = column(s.pv, "--pv", "process variable pv")?;
+    let mut sp = s.sp.map(|c| column(c, "--sp", "setpoint sp")).transpose()?;
+    let mut mv =
+        s.mv.map(|c| column(c, "--mv", "valve position mv"))
+            .transpose()?;
+    let mut auto = match s.mode {
+        Some(c) => {
+            let col = table.require(c, "--mode", "controller mode")?;
+            let k = table.missing(col);
+            if k > 0 {
+                missing.push((table.headers[col].clone(), k));
+            }
+            Some(table.modes(col)?)
+        }
+        None => None,
+    };
+    let mut notes = Vec::new();
+    let time_col = data::time_column(table, s.time)?;
+    let mut time = match time_col {
+        Some(c) => {
+            let axis = table.time_axis(c, spec)?;
+            notes.extend(axis.notes);
+            if axis.missing > 0 {
+                missing.push((table.headers[c].clone(), axis.missing));
+            }
+            Some(axis.seconds)
+        }
+        None => None,
+    };
+    if let Some(t) = &mut time {
+        // a row without its time is a gap; its time is filled in so the axis stays whole
+        for k in 0..t.len() {
+            if t[k].is_nan() {
+                op[k] = f64::NAN;
+                pv[k] = f64::NAN;
+                if let Some(sp) = &mut sp {
+                    sp[k] = f64::NAN;
+                }
+                if let Some(mv) = &mut mv {
+                    mv[k] = f64::NAN;
+                }
+            }
+        }
+        if !fill_times(t) {
+            notes.push("the time column has no values; it is left out".into());
+            time = None;
+        }
+    }
+    let mut rows = None;
+    if let Some(t) = &time {
+        if let Some((keep, note)) = time_order(t) {
+            notes.push(note);
+            let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
+            op = pick(&op);
+            pv = pick(&pv);
+            sp = sp.as_deref().map(pick);
+            mv = mv.as_deref().map(pick);
+            auto = auto.map(|a| keep.iter().map(|&k| a[k]).collect());
+            time = Some(pick(t));
+            rows = Some(keep);
+        }
+    }
+    let ts = match (s.ts, &time) {
+        (Some(ts), _) => ts,
+        (None, Some(t)) => data::sampling_time(t).with_context(|| {
+            format!(
+                "{file}: the time column '{}' does not increase; give the sampling time with --ts SECONDS",
+                table.headers[time_col.unwrap_or(0)]
+            )
+        })?,
+        (None, None) => 1.0,
+    };
+    Ok(LoopFile {
+        op,
+        pv,
+        sp,
+        mv,
+        time,
+        auto,
+        ts,
+        missing,
+        notes,
+        rows,
+    })
+}
+
+/// Fill NaN times by straight lines between their neighbours (by the median step past the
+/// ends). False when no time is known.
+fn fill_times(t: &mut [f64]) -> bool {
+    let known: Vec<usize> = (0..t.len()).filter(|&k| t[k].is_finite()).collect();
+    let (Some(&first), Some(&last)) = (known.first(), known.last()) else {
+        return false;
+    };
+    // the median step per sample between known times (neighbours or not)
+    let mut steps: Vec<f64> = known
+        .windows(2)
+        .map(|w| (t[w[1]] - t[w[0]]) / (w[1] - w[0]) as f64)
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    let step = steps.get(steps.len() / 2).copied().unwrap_or(1.0);
+    for k in 0..first {
+        t[k] = t[first] - (first - k) as f64 * step;
+    }
+    for k in last + 1..t.len() {
+        t[k] = t[last] + (k - last) as f64 * step;
+    }
+    for w in known.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        for k in a + 1..b {
+            t[k] = t[a] + (t[b] - t[a]) * (k - a) as f64 / (b - a) as f64;
+        }
+    }
+    true
+}
+
+/// The rows to keep, in time order, when the file is not in time order or repeats a time
+/// (the first row of each time kept), with a note; `None` when time only increases.
+fn time_order(t: &[f64]) -> Option<(Vec<usize>, String)> {
+    if t.windows(2).all(|w| w[1] > w[0]) {
+        return None;
+    }
+    let backwards = t.windows(2).filter(|w| w[1] < w[0]).count();
+    let mut keep: Vec<usize> = (0..t.len()).collect();
+    keep.sort_by(|&a, &b| t[a].total_cmp(&t[b]).then(a.cmp(&b)));
+    let before = keep.len();
+    keep.dedup_by(|b, a| t[*a] == t[*b]);
+    let repeats = before - keep.len();
+    let mut said = Vec::new();
+    if backwards > 0 {
+        said.push(format!(
+            "the rows are not in time order ({} back): sorted by time",
+            count(backwards, "step goes", "steps go")
+        ));
+    }
+    if repeats > 0 {
+        said.push(format!(
+            "{} an earlier row's time: the first row of each time is kept",
+            count(repeats, "row repeats", "rows repeat")
+        ));
+    }
+    Some((keep, said.join("; ")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn missing_times_are_filled_between_neighbours() {
+        let nan = f64::NAN;
+        let mut t = [nan, 1.0, nan, nan, 4.0, nan];
+        assert!(fill_times(&mut t));
+        assert_eq!(t, [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+        assert!(!fill_times(&mut [nan, nan]));
+    }
+
+    #[test]
+    fn rows_are_sorted_and_repeats_dropped() {
+        assert!(time_order(&[0.0, 1.0, 2.0]).is_none());
+        let (keep, note) = time_order(&[0.0, 2.0, 1.0, 2.0, 3.0]).unwrap();
+        assert_eq!(keep, vec![0, 2, 1, 4]);
+        assert!(
+            note.contains("1 step goes back") && note.contains("1 row repeats"),
+            "{note}"
+        );
+    }
+}
