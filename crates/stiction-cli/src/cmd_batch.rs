@@ -1,35 +1,44 @@
 //! `stiction batch`: diagnose many loops in parallel and rank them.
 //!
-//! Inputs are streamed: a reader thread turns the INPUT arguments into one job per loop (a
+//! Inputs are streamed (see `pipeline`): a reader thread turns the INPUT arguments into one job per loop (a
 //! long-format file is read once, front to back, one loop at a time) and hands them over a bounded
 //! channel to a rayon pool; each worker reads its loop, diagnoses it, writes `loops/<id>.json`
 //! (and a report) and sends back a small summary row. Only those rows are kept, so memory stays
 //! flat however many loops there are. The summary is ranked with a total order (severity, verdict,
 //! loop id), so it is the same for any number of threads, and rewritten every few seconds, so an
-//! interrupted run loses nothing: `--resume` picks up from the `loops/<id>.json` already written.
+//! interrupted run loses nothing: `--resume` picks up from the `loops/<id>.json` already written,
+//! checking that each loop's input is unchanged (`resume`). One run writes into a folder at a
+//! time (`lock`); a signal stops the batch cleanly (`stop`); every file is written atomically
+//! (`crate::atomic`), so a crash or a full disk never leaves half a file.
 //!
 //! Loop ids: a file's stem, or the loop id cell of a long-format file, made a safe file name
 //! (characters other than letters, digits and `- _ . + ~` become `_`). Ids used twice get a
 //! suffix in input order (`X`, `X~2`, `X~3`), with a note; the `source` column says which is which.
 
+mod classify;
 mod html;
 mod inputs;
+mod layout;
+mod lock;
+mod long;
+mod pipeline;
 mod progress;
+mod resume;
+mod stop;
 mod summary;
 
-use crate::cmd_diagnose::{Columns, LoopFile};
-use crate::cmd_simulate::write_atomic;
-use crate::data;
+use crate::atomic::{remove_stale_temps, write_atomic};
+use crate::cmd_diagnose::Columns;
 use anyhow::{bail, Context, Result};
-use inputs::{Ids, Job, JobData};
-use progress::Progress;
-use rayon::prelude::*;
+use layout::{Layout, LoopList, TagPattern};
+use pipeline::Ctx;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::sync::mpsc;
-use std::time::{Duration, Instant};
-use stiction_core::diagnose::{diagnose, Diagnosis};
-use summary::{Row, VERDICTS};
+use std::sync::Arc;
+use std::time::Instant;
+use stiction_core::fleet::Outcome;
+use stop::{Reason, Stop};
+use summary::{Fate, Row, SourceStatus};
 
 #[derive(clap::Args, Clone)]
 #[command(
@@ -38,14 +47,41 @@ use summary::{Row, VERDICTS};
   stiction batch plant/ -o out --sp sp
   stiction batch 'plant/*.csv' more/FIC101.csv -o out --op OP --pv PV --threads 4 --reports
   stiction batch historian.csv -o out --loop-id tag --sp SP --no-quantify
+  stiction batch exports/ -o out --tags '{loop}.{role}'   # columns FIC101.OP, FIC101.PV, LIC7.OP, ...
+  stiction batch exports/ -o out --columns loops.toml     # a plant's loop list
   stiction batch plant/ -o out --sp sp --resume      # after an interruption: done loops are kept
 
 Writes OUTDIR/summary.csv and summary.json (one row per loop, ranked by severity = apparent
 stiction x confidence for a stiction verdict, then verdict, then loop id), OUTDIR/loops/<id>.json
-(the full diagnosis), and with --reports OUTDIR/reports/<id>.html and OUTDIR/index.html. A loop
-that cannot be read is a 'failed' row with the reason; the batch goes on.
-Loop ids: the file stem, or the loop id cell of a long-format file, as a safe file name; an id
-used twice gets a suffix in input order (X, X~2, X~3), with a note."
+(the full diagnosis and where it came from), and with --reports OUTDIR/reports/<id>.html and
+OUTDIR/index.html. A loop that cannot be read is a 'failed' row with the reason; the batch goes on.
+Loop ids: the file stem, the loop id cell of a long-format file, or the loop's name in a loop list
+or tag pattern, as a safe file name; an id used twice gets a suffix in input order (X, X~2, X~3),
+with a note.
+
+A loop list (--columns) names each loop's columns and options, one [[loop]] table per loop in
+TOML or one row per loop in CSV (columns id, file, op, pv, sp, mode, mv, time, integrating, ts):
+  [[loop]]
+  id = \"FIC101\"
+  op = \"FIC101.OP\"
+  pv = \"FIC101.PV\"
+  sp = \"FIC101.SP\"
+  [[loop]]
+  id = \"LIC7\"
+  file = \"unit2.csv\"     # optional, relative to the list; else every input with the op column
+  op = \"LIC7.OP\"
+  pv = \"LIC7.PV\"
+  integrating = true
+  ts = 5
+A loop left out of the list's options takes the flags' (--time, --ts, --integrating). A loop whose
+list names a column its file lacks is a failed row naming file, column and loop.
+
+One writer per OUTDIR (a lock, OUTDIR/batch.lock): a second run into the same folder stops at once.
+Ctrl-C or SIGTERM stops handing out loops, lets running loops finish and writes the summary of
+what is done (exit 130 / 143); a second signal stops at once. --resume diagnoses again every loop
+whose input or settings changed, and keeps, marked 'vanished', a loop whose input is gone.
+Exit status: 0 every loop diagnosed, 3 finished with failed loops, 2 unusable arguments or files
+that cannot be written, 130 / 143 stopped by a signal."
 )]
 pub struct Args {
     /// Folders (every *.csv directly inside), file patterns such as 'plant/*.csv' (quoted), CSV
@@ -61,13 +97,26 @@ pub struct Args {
     /// The column of a long-format file that names the loop of each row
     #[arg(long, default_value = "loop_id", value_name = "COL")]
     pub loop_id: String,
+    /// A loop list naming each loop's columns (op, pv, sp, mode, mv, time) and options
+    /// (integrating, ts): TOML ([[loop]] tables) or CSV (a row per loop); see below
+    #[arg(
+        long = "columns",
+        value_name = "FILE.toml|FILE.csv",
+        conflicts_with = "tags"
+    )]
+    pub loop_list: Option<PathBuf>,
+    /// Split wide exports into loops by their column names: PATTERN holds {loop} and {role}
+    /// (op, pv, sp, mode or mv; any case), e.g. '{loop}.{role}' for FIC101.OP, FIC101.PV, LIC7.OP
+    #[arg(long, value_name = "PATTERN")]
+    pub tags: Option<String>,
     /// Worker threads [default: one per CPU]
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
     /// Also write an HTML report per loop (OUTDIR/reports/<id>.html) and OUTDIR/index.html
     #[arg(long)]
     pub reports: bool,
-    /// Keep the loops whose OUTDIR/loops/<id>.json exists (an interrupted run) instead of diagnosing them again
+    /// Keep the loops whose OUTDIR/loops/<id>.json exists (an interrupted run) instead of
+    /// diagnosing them again, unless their input or settings changed
     #[arg(long)]
     pub resume: bool,
     /// Skip the closed-loop estimate of the band (faster; severity then uses the ellipse estimate)
@@ -75,38 +124,31 @@ pub struct Args {
     pub no_quantify: bool,
 }
 
-/// What every worker needs.
-struct Ctx {
-    columns: Columns,
-    quantify: bool,
-    out: PathBuf,
-    loops_dir: PathBuf,
-    reports_dir: Option<PathBuf>,
-    resume: bool,
-}
-
-/// The loop's full report (`stiction report`), with a link back to the fleet's index page.
-fn write_loop_report(path: &Path, loop_id: &str, lf: &LoopFile, d: &Diagnosis) -> Result<()> {
-    let html = crate::cmd_report::render(loop_id, lf, d)?.replacen(
-        "<main>\n",
-        "<main>\n<p class=\"back\"><a href=\"../index.html\">&larr; all loops</a></p>\n",
-        1,
-    );
-    crate::cmd_simulate::write_atomic(path, html.as_bytes())
-}
-
-/// The settings that decide a loop's diagnosis: `--resume` refuses to mix loops diagnosed with
-/// different ones.
+/// The settings that decide every loop's diagnosis: `--resume` refuses to mix loops diagnosed
+/// with different ones. (Each loop's JSON also records its own columns and options, so a loop
+/// whose line of a loop list changed is diagnosed again.)
 fn settings(a: &Args) -> Value {
     let c = &a.columns;
     serde_json::json!({
         "op": c.op, "pv": c.pv, "sp": c.sp, "mode": c.mode, "time": c.time, "ts": c.ts,
         "integrating": c.integrating, "quantify": !a.no_quantify, "loop_id": a.loop_id,
-        "estimate_start": c.estimate_start,
+        "estimate_start": c.estimate_start, "tags": a.tags,
     })
 }
 
-pub fn run(a: Args) -> Result<()> {
+/// Where each loop's columns are, from `--columns` or `--tags`.
+fn layout(a: &Args) -> Result<Layout> {
+    Ok(match (&a.loop_list, &a.tags) {
+        (Some(list), _) => Layout::List(LoopList::read(list, &a.columns)?),
+        (None, Some(tags)) => Layout::Tags(TagPattern::parse(tags)?),
+        (None, None) => Layout::Flags,
+    })
+}
+
+/// Run the batch. The exit status: 0 when every loop was diagnosed, 3 when the batch finished
+/// but some loops failed, 130 / 143 when stopped by SIGINT / SIGTERM; an error (exit 2) for
+/// unusable arguments, a folder another run holds, or files that cannot be written.
+pub fn run(a: Args) -> Result<u8> {
     let started = Instant::now();
     if let Some(ts) = a.columns.ts {
         if !(ts > 0.0 && ts.is_finite()) {
@@ -118,6 +160,7 @@ pub fn run(a: Args) -> Result<()> {
         Some(n) => n,
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
+    let layout = layout(&a)?;
     let mut files = inputs::expand(&a.inputs)?;
     // OUTDIR given as an input folder too: its own summary is not a loop
     if let Ok(own) = std::fs::canonicalize(a.output.join("summary.csv")) {
@@ -129,15 +172,25 @@ pub fn run(a: Args) -> Result<()> {
             );
         }
     }
-    let inputs = inputs::classify(files, &a.loop_id, &a.columns)?;
-    let ctx = prepare_output(&a)?;
-    let (mut rows, ids) = diagnose_all(inputs, &ctx, threads)?;
-    let out = &a.output;
-    summary::write(out, &mut rows, true)
-        .with_context(|| format!("{}: cannot write the summary", out.display()))?;
-    if a.reports {
-        html::write_index(out, &rows, true)?;
+    let inputs = classify::classify(files, &a.loop_id, &a.columns, layout)?;
+    let known = inputs.known_loops();
+    let (_lock, ctx) = prepare_output(&a)?;
+    for note in &inputs.notes {
+        eprintln!("note: {note}");
     }
+    let (mut rows, ids) = pipeline::diagnose_all(inputs, &ctx, threads)?;
+    let stopped = ctx.stop.reason();
+    if a.resume && stopped.is_none() {
+        rows.extend(pipeline::vanished(&ctx.loops_dir, &ids));
+    }
+    let out = &a.output;
+    let written = summary::write(out, &mut rows, stopped.is_none()).and_then(|()| {
+        if a.reports {
+            html::write_index(out, &rows, stopped.is_none())
+        } else {
+            Ok(())
+        }
+    });
     for note in &ids.notes {
         eprintln!("note: {note}");
     }
@@ -147,25 +200,56 @@ pub fn run(a: Args) -> Result<()> {
             ids.duplicates - ids.notes.len()
         );
     }
-    print_outcome(
-        &rows,
-        out,
-        started.elapsed().as_secs_f64(),
-        threads,
-        a.reports,
-    );
-    Ok(())
+    let done = match known {
+        Some(m) => format!("{} of {m} loops", rows.len()),
+        None => format!("{} loops", rows.len()),
+    };
+    let summary_failed = |e: anyhow::Error| {
+        anyhow::anyhow!(
+            "{}: cannot write the summary ({e:#}); the result of every loop done is in {}: free space and run the same command with --resume to write it",
+            out.display(),
+            ctx.loops_dir.display()
+        )
+    };
+    match stopped {
+        Some(Reason::Fault(why)) => bail!(
+            "stopped after {done}: {why}; free space (or choose another folder with -o OUTDIR) and run the same command with --resume to finish"
+        ),
+        Some(Reason::Signal(sig)) => {
+            written.map_err(summary_failed)?;
+            eprintln!("stopped after {done}; run the same command with --resume to finish");
+            Ok((128 + sig) as u8)
+        }
+        None => {
+            written.map_err(summary_failed)?;
+            let secs = started.elapsed().as_secs_f64();
+            print_outcome(&rows, out, secs, threads, a.reports, a.resume);
+            let failed = summary::counts(&rows).failed;
+            Ok(if failed > 0 { 3 } else { 0 })
+        }
+    }
 }
 
-/// Make OUTDIR ready: its folders, the settings of this run (checked against the earlier run's
-/// with `--resume`), an empty summary so a stale one never passes for this run's.
-fn prepare_output(a: &Args) -> Result<Ctx> {
+/// Make OUTDIR ready: its lock (before anything is written), the temporary files a killed run
+/// left removed, its folders, the settings of this run (checked against the earlier run's with
+/// `--resume`), an empty summary so a stale one never passes for this run's.
+fn prepare_output(a: &Args) -> Result<(lock::Lock, Ctx)> {
     let out = &a.output;
     let shown = out.display();
-    let loops_dir = out.join("loops");
-    std::fs::create_dir_all(&loops_dir).with_context(|| {
+    std::fs::create_dir_all(out).with_context(|| {
         format!("{shown}: cannot create the output folder; choose a writable folder with -o OUTDIR")
     })?;
+    let lock = lock::take(out)?;
+    let loops_dir = out.join("loops");
+    let reports_dir = a.reports.then(|| out.join("reports"));
+    for dir in [Some(out), Some(&loops_dir), reports_dir.as_ref()]
+        .into_iter()
+        .flatten()
+    {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
+        remove_stale_temps(dir);
+    }
     let settings_path = out.join("batch.json");
     let settings = settings(a);
     if a.resume {
@@ -180,106 +264,29 @@ fn prepare_output(a: &Args) -> Result<Ctx> {
             }
         }
     }
-    write_atomic(&settings_path, &serde_json::to_vec_pretty(&settings)?).with_context(|| {
-        format!("{shown}: the output folder is not writable; choose another with -o OUTDIR")
-    })?;
-    summary::write(out, &mut [], false)?;
-    let reports_dir = a.reports.then(|| out.join("reports"));
-    if let Some(dir) = &reports_dir {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
-    }
+    let again = "free space (or choose another folder with -o OUTDIR) and run the command again";
+    write_atomic(&settings_path, &serde_json::to_vec_pretty(&settings)?)
+        .and_then(|()| summary::write(out, &mut [], false))
+        .map_err(|e| anyhow::anyhow!("{e:#}; {again}"))?;
     // left by an interrupted run of an earlier version
     let _ = std::fs::remove_dir_all(out.join(".batch-tmp"));
-    Ok(Ctx {
-        columns: a.columns.clone(),
+    let ctx = Ctx {
+        flags: a.columns.clone(),
         quantify: !a.no_quantify,
         out: out.clone(),
         loops_dir,
         reports_dir,
         resume: a.resume,
-    })
+        stop: Arc::new(Stop::install().context("cannot install the signal handlers")?),
+    };
+    Ok((lock, ctx))
 }
 
-/// The pipeline: a reader thread streams jobs over a bounded channel into the pool; a collector
-/// thread keeps the rows, shows the progress and rewrites the summary every 2 s.
-fn diagnose_all(inputs: inputs::Inputs, ctx: &Ctx, threads: usize) -> Result<(Vec<Row>, Ids)> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .thread_name(|i| format!("batch-worker{i}"))
-        .build()
-        .context("cannot start the worker threads")?;
-    let (job_tx, job_rx) = mpsc::sync_channel::<Job>(4 * threads + 8);
-    let (row_tx, row_rx) = mpsc::channel::<(Row, u64)>();
-    let mut progress = Progress::new(inputs.known_loops(), inputs.total_bytes);
-    let reader = std::thread::Builder::new()
-        .name("batch-reader".into())
-        .spawn(move || inputs::stream(inputs.sources, job_tx))
-        .context("cannot start the reader thread")?;
-    let out = ctx.out.clone();
-    let with_index = ctx.reports_dir.is_some();
-    let collector = std::thread::Builder::new()
-        .name("batch-collector".into())
-        .spawn(move || {
-            let mut rows: Vec<Row> = Vec::new();
-            let mut last_write = Instant::now();
-            let mut warned = false;
-            for (row, weight) in row_rx {
-                rows.push(row);
-                progress.tick(weight);
-                if last_write.elapsed() >= Duration::from_secs(2) {
-                    last_write = Instant::now();
-                    let written = summary::write(&out, &mut rows, false).and_then(|()| {
-                        if with_index {
-                            html::write_index(&out, &rows, false)
-                        } else {
-                            Ok(())
-                        }
-                    });
-                    if let Err(e) = written {
-                        if !warned {
-                            progress.println(&format!("warning: the interim summary: {e:#}"));
-                            warned = true;
-                        }
-                    }
-                }
-            }
-            progress.finish();
-            rows
-        })
-        .context("cannot start the collector thread")?;
-    pool.install(|| {
-        job_rx
-            .into_iter()
-            .par_bridge()
-            .for_each_with(row_tx, |tx, job| {
-                let (id, source, weight) = (job.id.clone(), job.source.clone(), job.weight);
-                // a bug in one loop's path is that loop's failure, never the batch's
-                let row = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    process(job, ctx)
-                }))
-                .unwrap_or_else(|_| {
-                    Row::failed(
-                        &id,
-                        &source,
-                        format!("{source}: stopped on an internal error (a bug: please report it with this file)"),
-                    )
-                });
-                let _ = tx.send((row, weight));
-            })
-    });
-    let ids = reader.join().expect("the reader thread does not panic");
-    let rows = collector
-        .join()
-        .expect("the collector thread does not panic");
-    Ok((rows, ids))
-}
-
-fn print_outcome(rows: &[Row], out: &Path, secs: f64, threads: usize, reports: bool) {
+fn print_outcome(rows: &[Row], out: &Path, secs: f64, threads: usize, reports: bool, resume: bool) {
     let counts = summary::counts(rows);
-    let parts: Vec<String> = VERDICTS
+    let parts: Vec<String> = Outcome::ALL
         .iter()
-        .zip(counts)
+        .map(|&v| (v, counts.get(v)))
         .filter(|(_, n)| *n > 0)
         .map(|(v, n)| format!("{n} {v}"))
         .collect();
@@ -293,17 +300,34 @@ fn print_outcome(rows: &[Row], out: &Path, secs: f64, threads: usize, reports: b
             parts.join(", ")
         }
     );
-    let resumed = rows.iter().filter(|r| r.resumed).count();
-    if resumed > 0 {
-        println!("  {resumed} of them kept from an earlier run (--resume)");
+    if resume {
+        // failed loops are counted apart (they are tried again on every resume)
+        let n = |f: Fate, s: SourceStatus| {
+            rows.iter()
+                .filter(|r| r.fleet.verdict != Outcome::Failed)
+                .filter(|r| r.fate == f && r.source_status == s)
+                .count()
+        };
+        let vanished = n(Fate::Kept, SourceStatus::Vanished);
+        println!(
+            "  resume: {} kept, {} redone because their input or settings changed, {} new{}",
+            n(Fate::Kept, SourceStatus::Present),
+            n(Fate::Redone, SourceStatus::Present),
+            n(Fate::New, SourceStatus::Present),
+            if vanished > 0 {
+                format!(", {vanished} kept whose input is gone (source_status vanished)")
+            } else {
+                String::new()
+            }
+        );
     }
-    if counts[4] > 0 {
+    if counts.failed > 0 {
         println!(
             "  {} failed; the reason of each is in the error column of {}",
-            if counts[4] == 1 {
+            if counts.failed == 1 {
                 "1 loop".to_string()
             } else {
-                format!("{} loops", counts[4])
+                format!("{} loops", counts.failed)
             },
             out.join("summary.csv").display()
         );
@@ -321,121 +345,9 @@ fn print_outcome(rows: &[Row], out: &Path, secs: f64, threads: usize, reports: b
     );
 }
 
-/// "line N" in a message about a loop of a long-format file (read as a small CSV: header on line
-/// 1, row k on line k + 2) becomes the line of the long file.
-fn remap_lines(msg: &str, lines: &[u64]) -> String {
-    let mut out = String::with_capacity(msg.len());
-    let mut rest = msg;
-    while let Some(i) = rest.find("line ") {
-        out.push_str(&rest[..i + 5]);
-        rest = &rest[i + 5..];
-        let digits = rest.bytes().take_while(u8::is_ascii_digit).count();
-        let mapped = rest[..digits]
-            .parse::<usize>()
-            .ok()
-            .and_then(|n| n.checked_sub(2))
-            .and_then(|k| lines.get(k));
-        match mapped {
-            Some(line) => out.push_str(&line.to_string()),
-            None => out.push_str(&rest[..digits]),
-        }
-        rest = &rest[digits..];
-    }
-    out.push_str(rest);
-    out
-}
-
-/// Read one loop. A long-format loop's rows are read from memory by `data::Table` and
-/// `Columns::read` (shared with `diagnose`) exactly as a file of its own; their messages are
-/// then pointed at the long file's lines.
-fn read_loop(data: JobData, ctx: &Ctx) -> Result<LoopFile, String> {
-    match data {
-        JobData::File(path) => data::Table::read(&path)
-            .and_then(|t| ctx.columns.read(&t))
-            .map_err(|e| format!("{e:#}")),
-        JobData::Rows { file, csv, lines } => data::Table::parse(&file, &csv)
-            .and_then(|t| ctx.columns.read(&t))
-            .map_err(|e| remap_lines(&format!("{e:#}"), &lines)),
-        JobData::Fail(why) => Err(why),
-    }
-}
-
-/// Diagnose one loop: never panics, never fails the batch; a loop that cannot be read or
-/// diagnosed is a `failed` row with the reason.
-fn process(job: Job, ctx: &Ctx) -> Row {
-    let Job {
-        id, source, data, ..
-    } = job;
-    let json_path = ctx.loops_dir.join(format!("{id}.json"));
-    let report_path = ctx
-        .reports_dir
-        .as_ref()
-        .map(|d| d.join(format!("{id}.html")));
-    if ctx.resume && report_path.as_ref().is_none_or(|p| p.exists()) {
-        let old = std::fs::read(&json_path)
-            .ok()
-            .and_then(|b| serde_json::from_slice::<Value>(&b).ok());
-        if let Some(row) = old.and_then(|v| Row::from_json(&id, &source, &v)) {
-            return Row {
-                resumed: true,
-                report: report_path.is_some(),
-                ..row
-            };
-        }
-    }
-    let lf = match read_loop(data, ctx) {
-        Ok(lf) => lf,
-        Err(why) => return Row::failed(&id, &source, why),
-    };
-    let mut req = ctx.columns.request(lf.ts);
-    req.quantify = ctx.quantify;
-    let d = match diagnose(&lf.record(), &req) {
-        Ok(d) => d,
-        Err(e) => return Row::failed(&id, &source, format!("{source}: {e}")),
-    };
-    // the row is read back from the JSON as written, exactly as `--resume` reads it
-    let written = serde_json::to_vec_pretty(&d)
-        .map_err(anyhow::Error::from)
-        .and_then(|bytes| {
-            write_atomic(&json_path, &bytes)?;
-            Ok(serde_json::from_slice::<Value>(&bytes)?)
-        });
-    let value = match written {
-        Ok(v) => v,
-        Err(e) => return Row::failed(&id, &source, format!("{e:#}")),
-    };
-    let Some(mut row) = Row::from_json(&id, &source, &value) else {
-        return Row::failed(
-            &id,
-            &source,
-            format!("{source}: the diagnosis has no verdict (a bug: please report it)"),
-        );
-    };
-    if let Some(path) = report_path {
-        match write_loop_report(&path, &id, &lf, &d) {
-            Ok(()) => row.report = true,
-            Err(e) => row.error = format!("the report was not written: {e:#}"),
-        }
-    }
-    row
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn lines_of_a_loop_map_to_the_long_file() {
-        let lines = [100, 101, 105];
-        assert_eq!(
-            remap_lines("x.csv: line 4, column 'op': 'a' is not a number", &lines),
-            "x.csv: line 105, column 'op': 'a' is not a number"
-        );
-        assert_eq!(
-            remap_lines("ends at line 2 with 0 values; line 9", &lines),
-            "ends at line 100 with 0 values; line 9"
-        );
-    }
 
     #[test]
     fn ids_are_file_names_and_unique() {

@@ -5,10 +5,19 @@ use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
 mod common;
-use common::{closed_stenman, fails, ok, stiction};
+use common::{closed_stenman, fails, stiction};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
+}
+
+/// Runs a batch that must finish with exit status `code` (3: some loops failed); its stdout.
+fn batch(args: &[&str], code: i32) -> String {
+    let out = stiction(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    String::from_utf8(out.stdout).unwrap()
 }
 
 /// A closed loop of 1500 samples with Stenman stiction `d` (0: a healthy valve).
@@ -85,7 +94,8 @@ fn a_folder_is_ranked_with_the_bad_loop_failed_and_the_rest_diagnosed() {
     let dir = tempfile::tempdir().unwrap();
     let plant = plant(dir.path());
     let out = dir.path().join("out");
-    let text = ok(&["batch", s(&plant), "-o", s(&out), "--sp", "sp"]);
+    // a failed loop: the batch finishes, writes everything, and exits 3
+    let text = batch(&["batch", s(&plant), "-o", s(&out), "--sp", "sp"], 3);
     assert!(text.contains("3 loops"), "{text}");
     assert!(text.contains("1 loop failed"), "{text}");
     let rows = summary(&out);
@@ -94,7 +104,7 @@ fn a_folder_is_ranked_with_the_bad_loop_failed_and_the_rest_diagnosed() {
     assert_eq!(rows[0]["loop_id"], "sticky");
     assert_eq!(rows[0]["verdict"], "stiction");
     let severity: f64 = rows[0]["severity"].parse().unwrap();
-    let band: f64 = rows[0]["apparent_stiction_closed_loop"].parse().unwrap();
+    let band: f64 = rows[0]["band_percent_of_span"].parse().unwrap();
     let confidence: f64 = rows[0]["confidence"].parse().unwrap();
     assert!(band > 1.0 && band < 3.0, "band {band}");
     assert!((severity - band * confidence).abs() < 1e-12);
@@ -137,26 +147,21 @@ fn one_or_two_threads_give_the_same_summary() {
     simulate(&plant.join("sticky_b.csv"), "3", "5");
     let one = dir.path().join("one");
     let two = dir.path().join("two");
-    ok(&[
-        "batch",
-        s(&plant),
-        "-o",
-        s(&one),
-        "--sp",
-        "sp",
-        "--threads",
-        "1",
-    ]);
-    ok(&[
-        "batch",
-        s(&plant),
-        "-o",
-        s(&two),
-        "--sp",
-        "sp",
-        "--threads",
-        "2",
-    ]);
+    for (dir, threads) in [(&one, "1"), (&two, "2")] {
+        batch(
+            &[
+                "batch",
+                s(&plant),
+                "-o",
+                s(dir),
+                "--sp",
+                "sp",
+                "--threads",
+                threads,
+            ],
+            3,
+        );
+    }
     let a = without_seconds(summary(&one));
     assert_eq!(a.len(), 4);
     assert_eq!(a, without_seconds(summary(&two)));
@@ -176,14 +181,17 @@ fn resume_keeps_the_loops_already_diagnosed() {
         "sp",
         "--no-quantify",
     ];
-    ok(&args);
+    batch(&args, 3);
     let first = summary(&out);
     let before = mtimes(&out.join("loops"));
     assert_eq!(before.len(), 2, "{before:?}");
     // a new loop arrives; the others are not diagnosed again
     simulate(&plant.join("new.csv"), "0", "9");
-    let text = ok(&[&args[..], &["--resume"]].concat());
-    assert!(text.contains("2 of them kept"), "{text}");
+    let text = batch(&[&args[..], &["--resume"]].concat(), 3);
+    assert!(
+        text.contains("resume: 2 kept, 0 redone because their input or settings changed, 1 new"),
+        "{text}"
+    );
     let after = mtimes(&out.join("loops"));
     for (name, t) in &before {
         assert_eq!(after[name], *t, "{name} was written again");
@@ -222,18 +230,21 @@ fn a_long_format_file_is_streamed_loop_by_loop() {
     let file = dir.path().join("historian.csv");
     std::fs::write(&file, long).unwrap();
     let out = dir.path().join("out");
-    ok(&[
-        "batch",
-        s(&file),
-        "-o",
-        s(&out),
-        "--sp",
-        "sp",
-        "--loop-id",
-        "tag",
-        "--no-quantify",
-        "--reports",
-    ]);
+    batch(
+        &[
+            "batch",
+            s(&file),
+            "-o",
+            s(&out),
+            "--sp",
+            "sp",
+            "--loop-id",
+            "tag",
+            "--no-quantify",
+            "--reports",
+        ],
+        3,
+    );
     let rows = summary(&out);
     let ids: Vec<&str> = rows.iter().map(|r| r["loop_id"].as_str()).collect();
     assert_eq!(ids, ["FIC-sticky", "FIC-healthy", "FIC-bad"]);
@@ -253,15 +264,18 @@ fn a_long_format_file_is_streamed_loop_by_loop() {
     );
     // the same verdicts as the loops read from their own files
     let own = dir.path().join("own");
-    ok(&[
-        "batch",
-        s(&plant),
-        "-o",
-        s(&own),
-        "--sp",
-        "sp",
-        "--no-quantify",
-    ]);
+    batch(
+        &[
+            "batch",
+            s(&plant),
+            "-o",
+            s(&own),
+            "--sp",
+            "sp",
+            "--no-quantify",
+        ],
+        3,
+    );
     let a: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("loops/FIC-sticky.json")).unwrap()).unwrap();
     let b: serde_json::Value =

@@ -1,15 +1,13 @@
-//! HTML for `--reports`: a page per loop and `index.html` ranking them. Self-contained (inline
-//! CSS, no scripts, nothing fetched from elsewhere).
-//!
-//! The per-loop page is a placeholder until `stiction report` lands: at merge time
-//! `write_loop_report` calls `crate::cmd_report::write_report` instead.
+//! `index.html` for `--reports`: every loop ranked, linking its report (`stiction report`'s
+//! page). Self-contained (inline CSS, no scripts, nothing fetched from elsewhere).
 
-use super::summary::{Row, VERDICTS};
+use super::summary::{Row, SourceStatus};
+use crate::atomic::write_atomic;
 use crate::cmd_report::esc;
-use crate::cmd_simulate::write_atomic;
 use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
+use stiction_core::fleet::Outcome;
 
 const STYLE: &str = "body{font-family:system-ui,sans-serif;margin:2em;color:#222;max-width:72em}\
 table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:.3em .6em;text-align:left;vertical-align:top}\
@@ -37,11 +35,16 @@ pub fn write_index(outdir: &Path, rows: &[Row], complete: bool) -> Result<()> {
     let mut b = String::new();
     let _ = writeln!(b, "<h1>Stiction batch: {} loops</h1>", rows.len());
     let counts = super::summary::counts(rows);
-    let parts: Vec<String> = VERDICTS
+    let parts: Vec<String> = Outcome::ALL
         .iter()
-        .zip(counts)
+        .map(|&v| (v, counts.get(v)))
         .filter(|(_, n)| *n > 0)
-        .map(|(v, n)| format!("<span class=\"{v}\">{n} {}</span>", v.replace('_', " ")))
+        .map(|(v, n)| {
+            format!(
+                "<span class=\"{v}\">{n} {}</span>",
+                v.as_str().replace('_', " ")
+            )
+        })
         .collect();
     let _ = writeln!(
         b,
@@ -56,10 +59,11 @@ pub fn write_index(outdir: &Path, rows: &[Row], complete: bool) -> Result<()> {
     );
     let _ = writeln!(
         b,
-        "<table><tr><th>#</th><th>loop</th><th>verdict</th><th>confidence</th><th>severity</th><th>apparent stiction</th><th>period (s)</th><th>reason</th></tr>"
+        "<table><tr><th>#</th><th>loop</th><th>verdict</th><th>confidence</th><th>severity</th><th>band (% of span)</th><th>period (s)</th><th>reason</th></tr>"
     );
-    for (k, r) in rows.iter().enumerate() {
-        let name = if r.report {
+    for (k, row) in rows.iter().enumerate() {
+        let r = &row.fleet;
+        let name = if row.report {
             format!(
                 "<a href=\"reports/{}.html\">{}</a>",
                 esc(&r.loop_id),
@@ -72,12 +76,16 @@ pub fn write_index(outdir: &Path, rows: &[Row], complete: bool) -> Result<()> {
             b,
             "<tr><td class=\"n\">{}</td><td>{name}<br><small>{}</small></td><td class=\"{}\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td></tr>",
             k + 1,
-            esc(&r.source),
-            esc(&r.verdict),
-            esc(&r.verdict.replace('_', " ")),
+            esc(&r.source)
+                + match row.source_status {
+                    SourceStatus::Present => "",
+                    SourceStatus::Vanished => " (no longer among the inputs: kept from an earlier run)",
+                },
+            r.verdict,
+            r.verdict.as_str().replace('_', " "),
             num(r.confidence, 2),
             num(Some(r.severity), 3),
-            num(r.apparent_stiction_closed_loop.or(r.apparent_stiction_ellipse), 3),
+            num(r.band_percent_of_span, 2),
             num(r.period_s, 1),
             esc(&r.reason)
         );

@@ -1,27 +1,43 @@
-//! What a batch reads: the INPUT arguments turned into sources (single-loop files and long-format
-//! files holding many loops), loop ids that are safe file names and unique, and the stream of
-//! jobs, one loop at a time, that the workers diagnose.
+//! What a batch reads: the INPUT arguments turned into sources (single-loop files, wide files
+//! holding several loops' columns, long-format files holding many loops' rows), loop ids that are
+//! safe file names and unique, and the stream of jobs, one loop at a time, that the workers
+//! diagnose.
 
+use super::layout::{LoopList, LoopSpec};
+use super::long::{stream_long, LongFile};
+use super::stop::Stop;
 use crate::cmd_diagnose::Columns;
+use crate::data::Table;
 use anyhow::{bail, Context, Result};
 use std::collections::{HashMap, HashSet};
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::SyncSender;
+use std::sync::Arc;
 
-/// A long-format file: many loops, the rows of each together, a column naming the loop.
-pub struct LongFile {
-    pub path: PathBuf,
-    pub delimiter: u8,
-    pub headers: Vec<String>,
-    /// Index of the loop id column.
-    pub id_col: usize,
+/// A loop found among a file's columns (by a loop list or a tag pattern).
+pub struct WideLoop {
+    pub raw_id: String,
+    pub source: String,
+    pub spec: LoopSpec,
+    /// Why the loop cannot be read (a column it names is missing), found from the header.
+    pub fail: Option<String>,
 }
 
 pub enum Source {
-    /// One loop per file; the loop id is the file stem.
+    /// One loop per file, the flags' columns; the loop id is the file stem.
     File(PathBuf),
+    /// The loops among one file's columns, each with its own.
+    Wide {
+        path: PathBuf,
+        loops: Vec<WideLoop>,
+    },
     Long(LongFile),
+    /// A loop of the loop list that cannot be read at all (its file does not exist).
+    Fail {
+        raw_id: String,
+        source: String,
+        why: String,
+    },
 }
 
 /// Everything the INPUT arguments name, in order, each file once.
@@ -29,15 +45,28 @@ pub struct Inputs {
     pub sources: Vec<Source>,
     /// Total size of the input files, bytes (the progress of long-format files is measured in bytes).
     pub total_bytes: u64,
+    /// What the classification noticed (files holding none of the listed loops).
+    pub notes: Vec<String>,
+    /// The loop list, and which of its loops were found so far.
+    pub list: Option<(Arc<LoopList>, Vec<bool>)>,
 }
 
 impl Inputs {
     /// Number of loops when known in advance (no long-format file).
     pub fn known_loops(&self) -> Option<usize> {
-        self.sources
-            .iter()
-            .all(|s| matches!(s, Source::File(_)))
-            .then_some(self.sources.len())
+        let mut n = 0;
+        for s in &self.sources {
+            n += match s {
+                Source::File(_) | Source::Fail { .. } => 1,
+                Source::Wide { loops, .. } => loops.len(),
+                Source::Long(_) => return None,
+            };
+        }
+        let unmatched = self
+            .list
+            .as_ref()
+            .map_or(0, |(_, used)| used.iter().filter(|u| !**u).count());
+        Some(n + unmatched)
     }
 }
 
@@ -48,11 +77,13 @@ pub struct Job {
     pub source: String,
     /// Bytes of input it stands for (for the progress).
     pub weight: u64,
+    /// Its columns and options.
+    pub spec: LoopSpec,
     pub data: JobData,
 }
 
 pub enum JobData {
-    /// A single-loop CSV file.
+    /// A CSV file to read.
     File(PathBuf),
     /// The rows of one loop of a long-format file, as a small CSV (header and rows), with the line
     /// of the long file each row comes from.
@@ -60,6 +91,12 @@ pub enum JobData {
         file: PathBuf,
         csv: Vec<u8>,
         lines: Vec<u64>,
+    },
+    /// One loop's columns of a file read once for all its loops; `hash` of the file's bytes.
+    Wide {
+        file: PathBuf,
+        table: Arc<Table>,
+        hash: String,
     },
     /// The loop cannot be read at all; the sentence says why.
     Fail(String),
@@ -122,87 +159,6 @@ pub fn expand(args: &[String]) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-/// The header line of a file (without a byte-order mark), or `None` when it cannot be read.
-fn header_line(path: &Path) -> Option<String> {
-    let mut r = BufReader::new(std::fs::File::open(path).ok()?);
-    let mut bytes = Vec::new();
-    r.read_until(b'\n', &mut bytes).ok()?;
-    let line = String::from_utf8_lossy(&bytes).into_owned();
-    Some(line.trim_start_matches('\u{feff}').trim_end().to_string())
-}
-
-fn split_header(line: &str, delimiter: u8) -> Vec<String> {
-    let mut r = csv::ReaderBuilder::new()
-        .delimiter(delimiter)
-        .has_headers(false)
-        .flexible(true)
-        .from_reader(line.as_bytes());
-    r.records()
-        .next()
-        .and_then(|x| x.ok())
-        .map(|rec| rec.iter().map(|h| h.trim().to_string()).collect())
-        .unwrap_or_default()
-}
-
-/// Sort the files into single-loop and long-format sources. A long-format file (one with the
-/// loop id column) must name the columns the flags ask for: it is checked here, once, rather than
-/// failing every one of its loops.
-pub fn classify(files: Vec<PathBuf>, loop_id_col: &str, columns: &Columns) -> Result<Inputs> {
-    let mut sources = Vec::with_capacity(files.len());
-    let mut total_bytes = 0;
-    for path in files {
-        total_bytes += std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-        let Some(line) = header_line(&path) else {
-            sources.push(Source::File(path));
-            continue;
-        };
-        let delimiter = crate::data::sniff_delimiter(&line);
-        let headers = split_header(&line, delimiter);
-        let find = |name: &str| {
-            headers
-                .iter()
-                .position(|h| h.eq_ignore_ascii_case(name.trim()))
-        };
-        let Some(id_col) = find(loop_id_col) else {
-            sources.push(Source::File(path));
-            continue;
-        };
-        let mut wanted = vec![
-            (columns.op.as_str(), "--op", "controller output op"),
-            (columns.pv.as_str(), "--pv", "process variable pv"),
-        ];
-        if let Some(c) = &columns.sp {
-            wanted.push((c, "--sp", "setpoint sp"));
-        }
-        if let Some(c) = &columns.mode {
-            wanted.push((c, "--mode", "controller mode"));
-        }
-        if let Some(c) = &columns.time {
-            wanted.push((c, "--time", "time"));
-        }
-        for (name, flag, role) in wanted {
-            if find(name).is_none() {
-                bail!(
-                    "{}: no column '{name}' for the {role} in this long-format file (it has a '{}' column); the columns are {}. Name the right one with {flag} COLUMN",
-                    path.display(),
-                    headers[id_col],
-                    headers.join(", ")
-                );
-            }
-        }
-        sources.push(Source::Long(LongFile {
-            path,
-            delimiter,
-            headers,
-            id_col,
-        }));
-    }
-    Ok(Inputs {
-        sources,
-        total_bytes,
-    })
-}
-
 /// A loop id as a file name: letters, digits and `- _ . + ~` kept, anything else `_`; never
 /// empty, never hidden, at most 120 characters.
 pub fn file_key(raw: &str) -> String {
@@ -240,6 +196,11 @@ pub struct Ids {
 }
 
 impl Ids {
+    /// Was `id` handed out (as a file name: ignoring case)?
+    pub fn contains(&self, id: &str) -> bool {
+        self.used.contains(&id.to_lowercase())
+    }
+
     pub fn assign(&mut self, raw: &str, source: &str) -> String {
         let key = file_key(raw);
         if self.used.insert(key.to_lowercase()) {
@@ -272,11 +233,18 @@ impl Ids {
     }
 }
 
-/// Stream every loop of every source into `tx`, one at a time. Returns the ids handed out (with
-/// their notes) when done, or early if the receiver hung up.
-pub fn stream(sources: Vec<Source>, tx: SyncSender<Job>) -> Ids {
+/// Stream every loop of every source into `tx`, one at a time, then a failed row for each loop
+/// of the loop list found nowhere. Returns the ids handed out (with their notes) when done, or
+/// early when the batch is asked to stop or the receiver hung up.
+pub fn stream(inputs: Inputs, flags: Columns, tx: SyncSender<Job>, stop: &Stop) -> Ids {
     let mut ids = Ids::default();
-    for source in sources {
+    let mut list = inputs.list;
+    let mut out = Out {
+        ids: &mut ids,
+        tx: &tx,
+        stop,
+    };
+    for source in inputs.sources {
         let more = match source {
             Source::File(path) => {
                 let stem = path
@@ -284,172 +252,113 @@ pub fn stream(sources: Vec<Source>, tx: SyncSender<Job>) -> Ids {
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_default();
                 let shown = path.display().to_string();
-                let job = Job {
-                    id: ids.assign(&stem, &shown),
-                    source: shown,
-                    weight: std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0),
-                    data: JobData::File(path),
-                };
-                tx.send(job).is_ok()
+                let weight = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+                out.send(
+                    &stem,
+                    shown,
+                    weight,
+                    LoopSpec::flags(&flags),
+                    JobData::File(path),
+                )
             }
-            Source::Long(long) => stream_long(&long, &mut ids, &tx),
+            Source::Wide { path, loops } => stream_wide(path, loops, &mut out),
+            Source::Long(long) => stream_long(&long, &flags, list.as_mut(), &mut out),
+            Source::Fail {
+                raw_id,
+                source,
+                why,
+            } => out.send(
+                &raw_id,
+                source,
+                0,
+                LoopSpec::flags(&flags),
+                JobData::Fail(why),
+            ),
         };
         if !more {
-            break;
+            return ids;
+        }
+    }
+    if let Some((list, used)) = list {
+        for (e, _) in list.entries.iter().zip(used).filter(|(_, u)| !*u) {
+            let why = format!(
+                "loop '{}' ({}): no input file has its op column '{}' and no long-format file has a loop '{}'; check the loop list and the inputs",
+                e.id, e.at, e.spec.columns.op, e.id
+            );
+            if !out.send(&e.id, e.at.clone(), 0, e.spec.clone(), JobData::Fail(why)) {
+                break;
+            }
         }
     }
     ids
 }
 
-/// The rows of one loop being gathered.
-struct Group {
-    raw_id: String,
-    writer: csv::Writer<Vec<u8>>,
-    lines: Vec<u64>,
-    start_byte: u64,
-    /// The loop's id was seen earlier in the file: its rows are not together.
-    split: bool,
+/// Where the jobs go.
+pub struct Out<'a> {
+    pub ids: &'a mut Ids,
+    pub tx: &'a SyncSender<Job>,
+    pub stop: &'a Stop,
 }
 
-/// Read a long-format file once, front to back, and send each loop as soon as its last row is
-/// read: only one loop's rows are held at a time.
-fn stream_long(long: &LongFile, ids: &mut Ids, tx: &SyncSender<Job>) -> bool {
-    let shown = long.path.display().to_string();
-    let size = std::fs::metadata(&long.path).map(|m| m.len()).unwrap_or(0);
-    let fail_rest = |ids: &mut Ids, why: String, weight: u64| {
-        let stem = long
-            .path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let id = ids.assign(&format!("{stem}~unread"), &shown);
-        tx.send(Job {
-            id,
-            source: shown.clone(),
-            weight,
-            data: JobData::Fail(why),
-        })
-        .is_ok()
-    };
-    let mut file = match std::fs::File::open(&long.path) {
-        Ok(f) => BufReader::with_capacity(1 << 20, f),
-        Err(e) => {
-            return fail_rest(ids, format!("{shown}: cannot be read: {e}"), size);
+impl Out<'_> {
+    /// Hand out a loop under a unique id; false when the batch stops or nobody listens.
+    pub fn send(
+        &mut self,
+        raw_id: &str,
+        source: String,
+        weight: u64,
+        spec: LoopSpec,
+        data: JobData,
+    ) -> bool {
+        if self.stop.requested() {
+            return false;
         }
-    };
-    if file
-        .fill_buf()
-        .is_ok_and(|b| b.starts_with(b"\xEF\xBB\xBF"))
-    {
-        file.consume(3);
+        let id = self.ids.assign(raw_id, &source);
+        self.tx
+            .send(Job {
+                id,
+                source,
+                weight,
+                spec,
+                data,
+            })
+            .is_ok()
     }
-    let mut reader = csv::ReaderBuilder::new()
-        .delimiter(long.delimiter)
-        .flexible(true)
-        .has_headers(true)
-        .from_reader(file);
-    let mut seen: HashSet<String> = HashSet::new();
-    let mut group: Option<Group> = None;
-    let mut record = csv::ByteRecord::new();
-    let id_name = &long.headers[long.id_col];
+}
 
-    // send the gathered loop; false if the receiver hung up
-    let emit = |group: Group, end_byte: u64, ids: &mut Ids| -> bool {
-        let first = group.lines.first().copied().unwrap_or(0);
-        let last = group.lines.last().copied().unwrap_or(0);
-        let mut source = format!("{shown} lines {first}-{last}");
-        if file_key(&group.raw_id) != group.raw_id {
-            source.push_str(&format!(" ({id_name} '{}')", group.raw_id));
-        }
-        let id = ids.assign(&group.raw_id, &source);
-        let data = if group.raw_id.is_empty() {
-            JobData::Fail(format!(
-                "{shown}: lines {first} to {last} have an empty '{id_name}' cell; fill in the loop id of every row"
-            ))
-        } else if group.split {
-            JobData::Fail(format!(
-                "{shown}: the rows of loop '{}' at lines {first} to {last} come after rows of other loops; \
-                 the rows of each loop must be together: sort the file by '{id_name}', keeping time order within each loop",
-                group.raw_id
-            ))
-        } else {
-            match group.writer.into_inner() {
-                Ok(csv) => JobData::Rows {
-                    file: long.path.clone(),
-                    csv,
-                    lines: group.lines,
-                },
-                Err(e) => JobData::Fail(format!("{shown}: lines {first} to {last}: {e}")),
-            }
-        };
-        tx.send(Job {
-            id,
-            source,
-            weight: end_byte.saturating_sub(group.start_byte),
-            data,
-        })
-        .is_ok()
-    };
-
-    loop {
-        let more = match reader.read_byte_record(&mut record) {
-            Ok(more) => more,
-            Err(e) => {
-                let at = e.position().map_or(0, |p| p.byte());
-                let line = e.position().map_or(0, |p| p.line());
-                if let Some(g) = group.take() {
-                    if !emit(g, at, ids) {
-                        return false;
-                    }
-                }
-                return fail_rest(
-                    ids,
-                    format!("{shown}: line {line} is not readable CSV ({e}); the loops from this line on were not read: repair the file"),
-                    size.saturating_sub(at),
-                );
-            }
-        };
-        if !more {
-            break;
-        }
-        if record.iter().all(|c| c.trim_ascii().is_empty()) {
-            continue; // a blank line
-        }
-        let (line, byte) = record.position().map_or((0, 0), |p| (p.line(), p.byte()));
-        let raw = record
-            .get(long.id_col)
-            .map(|c| String::from_utf8_lossy(c).trim().to_string())
-            .unwrap_or_default();
-        if group.as_ref().is_none_or(|g| g.raw_id != raw) {
-            if let Some(g) = group.take() {
-                if !emit(g, byte, ids) {
-                    return false;
-                }
-            }
-            let split = !seen.insert(raw.clone());
-            let mut writer = csv::WriterBuilder::new()
-                .delimiter(long.delimiter)
-                .flexible(true)
-                .from_writer(Vec::with_capacity(1 << 17));
-            // cannot fail: the writer writes to memory
-            let _ = writer.write_record(&long.headers);
-            group = Some(Group {
-                raw_id: raw,
-                writer,
-                lines: Vec::with_capacity(4096),
-                start_byte: byte,
-                split,
+/// The loops of a wide file: the file is read and parsed once, its table shared by its loops (a
+/// single loop reads its file itself, in a worker).
+fn stream_wide(path: PathBuf, loops: Vec<WideLoop>, out: &mut Out) -> bool {
+    let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    let weight = size / loops.len().max(1) as u64;
+    let usable = loops.iter().filter(|l| l.fail.is_none()).count();
+    let shared = if usable > 1 {
+        let read = std::fs::read(&path)
+            .map_err(|e| format!("{}: cannot be read: {e}", path.display()))
+            .and_then(|bytes| {
+                let hash = super::resume::hash(&bytes);
+                Table::parse(&path, &bytes)
+                    .map(|t| (Arc::new(t), hash))
+                    .map_err(|e| format!("{e:#}"))
             });
-        }
-        if let Some(g) = group.as_mut() {
-            if !g.split {
-                let _ = g.writer.write_byte_record(&record);
-            }
-            g.lines.push(line);
+        Some(read)
+    } else {
+        None
+    };
+    for l in loops {
+        let data = match (l.fail, &shared) {
+            (Some(why), _) => JobData::Fail(why),
+            (None, None) => JobData::File(path.clone()),
+            (None, Some(Ok((table, hash)))) => JobData::Wide {
+                file: path.clone(),
+                table: Arc::clone(table),
+                hash: hash.clone(),
+            },
+            (None, Some(Err(why))) => JobData::Fail(why.clone()),
+        };
+        if !out.send(&l.raw_id, l.source, weight, l.spec, data) {
+            return false;
         }
     }
-    match group.take() {
-        Some(g) => emit(g, size, ids),
-        None => true,
-    }
+    true
 }

@@ -1,0 +1,324 @@
+//! Ranking a fleet of loops: one typed summary row per loop, built from its [`Diagnosis`], and
+//! the order in which a maintenance planner should look at them.
+//!
+//! Every front end (the CLI's `batch`, the Python package) ranks with these functions, so the
+//! same diagnoses always give the same ranking. The order is total (severity, then verdict, then
+//! loop id): it never depends on which loop finished first or on the number of threads.
+
+use crate::diagnose::{BandSource, Diagnosis, Verdict, Vote};
+use serde::{Deserialize, Serialize};
+use std::cmp::Ordering;
+
+/// A loop's outcome in the fleet: its verdict, or `failed` when it could not be read or
+/// diagnosed. The order of the variants is the ranking order at equal severity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    Stiction,
+    Undetermined,
+    NoStiction,
+    InsufficientData,
+    Failed,
+}
+
+impl Outcome {
+    /// Every outcome, in ranking order.
+    pub const ALL: [Outcome; 5] = [
+        Outcome::Stiction,
+        Outcome::Undetermined,
+        Outcome::NoStiction,
+        Outcome::InsufficientData,
+        Outcome::Failed,
+    ];
+
+    /// The name used in files (`no_stiction`), as serde writes it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Outcome::Stiction => "stiction",
+            Outcome::Undetermined => "undetermined",
+            Outcome::NoStiction => "no_stiction",
+            Outcome::InsufficientData => "insufficient_data",
+            Outcome::Failed => "failed",
+        }
+    }
+}
+
+impl From<Verdict> for Outcome {
+    fn from(v: Verdict) -> Self {
+        match v {
+            Verdict::Stiction => Outcome::Stiction,
+            Verdict::Undetermined => Outcome::Undetermined,
+            Verdict::NoStiction => Outcome::NoStiction,
+            Verdict::InsufficientData => Outcome::InsufficientData,
+        }
+    }
+}
+
+impl std::fmt::Display for Outcome {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// One loop of the fleet summary (the columns of `stiction batch`'s summary.csv, in order).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    pub loop_id: String,
+    /// Where the loop came from, in words (a path, or a path and line range).
+    pub source: String,
+    pub verdict: Outcome,
+    /// The diagnosis' confidence; `None` for a failed loop.
+    pub confidence: Option<f64>,
+    /// See [`severity`].
+    pub severity: f64,
+    /// The stiction band of a `stiction` verdict, % of valve span, and where it comes from.
+    pub band_percent_of_span: Option<f64>,
+    pub band_source: Option<BandSource>,
+    /// The width of the ellipse fitted to an oscillation's PV-OP plot, % of valve span.
+    pub ellipse_percent_of_span: Option<f64>,
+    /// Oscillation period, seconds.
+    pub period_s: Option<f64>,
+    /// Thornhill's regularity of the oscillation; `None` when there is no oscillation analysis.
+    pub regularity: Option<f64>,
+    /// Why the verdict is what it is: the diagnosis' reason, else the indices' votes; for a
+    /// failed loop the error.
+    pub reason: String,
+    pub samples: Option<u64>,
+    /// Time the diagnosis took, seconds.
+    pub seconds: Option<f64>,
+    /// Why the loop could not be read or diagnosed (or, on a diagnosed loop, what went wrong
+    /// beside the diagnosis); empty otherwise.
+    pub error: String,
+}
+
+/// The severity of a loop, the ranking key: the stiction band in % of valve span times the
+/// confidence for a `stiction` verdict, else 0 (never raw OP units: loops whose OP is scaled
+/// differently rank alike).
+///
+/// The one place severity is defined: every ranking goes through here.
+pub fn severity(d: &Diagnosis) -> f64 {
+    if d.verdict != Verdict::Stiction {
+        return 0.0;
+    }
+    let band = d.band.as_ref().map_or(0.0, |b| b.band_percent_of_span);
+    band * d.confidence.unwrap_or(0.0)
+}
+
+fn vote_name(v: Vote) -> &'static str {
+    match v {
+        Vote::Stiction => "stiction",
+        Vote::NoStiction => "no_stiction",
+        Vote::Undetermined => "undetermined",
+    }
+}
+
+/// "votes: model stiction (0.310), stick_slip stiction (12), ...": why a verdict reached by the
+/// families is what it is. Empty without families.
+pub fn votes(d: &Diagnosis) -> String {
+    let parts: Vec<String> = d
+        .families
+        .iter()
+        .filter(|f| f.vote != Vote::Undetermined)
+        .map(|f| {
+            let name = f.family.as_str();
+            match f.value {
+                Some(v) if v.is_finite() => format!("{name} {} ({v:.3})", vote_name(f.vote)),
+                _ => format!("{name} {}", vote_name(f.vote)),
+            }
+        })
+        .collect();
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!("votes: {}", parts.join(", "))
+    }
+}
+
+impl Row {
+    /// The row of a diagnosed loop.
+    pub fn from_diagnosis(loop_id: &str, source: &str, d: &Diagnosis) -> Row {
+        Row {
+            loop_id: loop_id.into(),
+            source: source.into(),
+            verdict: d.verdict.into(),
+            confidence: d.confidence,
+            severity: severity(d),
+            band_percent_of_span: d.band.as_ref().map(|b| b.band_percent_of_span),
+            band_source: d.band.as_ref().map(|b| b.source),
+            ellipse_percent_of_span: d.band.as_ref().and_then(|b| b.ellipse_percent_of_span),
+            period_s: d.oscillation.as_ref().and_then(|o| o.period),
+            regularity: d.oscillation.as_ref().map(|o| o.regularity.regularity),
+            reason: d.reason.clone().unwrap_or_else(|| votes(d)),
+            samples: Some(d.samples as u64),
+            seconds: Some(d.seconds),
+            error: String::new(),
+        }
+    }
+
+    /// The row of a loop that could not be read or diagnosed: last in the ranking, the error
+    /// also as its reason.
+    pub fn failed(loop_id: &str, source: &str, error: String) -> Row {
+        Row {
+            loop_id: loop_id.into(),
+            source: source.into(),
+            verdict: Outcome::Failed,
+            confidence: None,
+            severity: 0.0,
+            band_percent_of_span: None,
+            band_source: None,
+            ellipse_percent_of_span: None,
+            period_s: None,
+            regularity: None,
+            reason: error.clone(),
+            samples: None,
+            seconds: None,
+            error,
+        }
+    }
+}
+
+/// Severity descending, then verdict (stiction, undetermined, no_stiction, insufficient_data,
+/// failed), then loop id: a total order (`f64::total_cmp`), so a ranking never depends on the
+/// order the rows arrived in.
+pub fn ranking(a: &Row, b: &Row) -> Ordering {
+    b.severity
+        .total_cmp(&a.severity)
+        .then(a.verdict.cmp(&b.verdict))
+        .then_with(|| a.loop_id.cmp(&b.loop_id))
+}
+
+/// Sort rows into the fleet ranking (see [`ranking`]).
+pub fn rank(rows: &mut [Row]) {
+    rows.sort_by(ranking);
+}
+
+/// Number of loops per outcome.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Counts {
+    pub stiction: usize,
+    pub undetermined: usize,
+    pub no_stiction: usize,
+    pub insufficient_data: usize,
+    pub failed: usize,
+}
+
+impl Counts {
+    /// Count the outcomes.
+    pub fn of(outcomes: impl IntoIterator<Item = Outcome>) -> Counts {
+        let mut c = Counts::default();
+        for o in outcomes {
+            *c.get_mut(o) += 1;
+        }
+        c
+    }
+
+    fn get_mut(&mut self, o: Outcome) -> &mut usize {
+        match o {
+            Outcome::Stiction => &mut self.stiction,
+            Outcome::Undetermined => &mut self.undetermined,
+            Outcome::NoStiction => &mut self.no_stiction,
+            Outcome::InsufficientData => &mut self.insufficient_data,
+            Outcome::Failed => &mut self.failed,
+        }
+    }
+
+    /// The number of loops with outcome `o`.
+    pub fn get(&self, o: Outcome) -> usize {
+        match o {
+            Outcome::Stiction => self.stiction,
+            Outcome::Undetermined => self.undetermined,
+            Outcome::NoStiction => self.no_stiction,
+            Outcome::InsufficientData => self.insufficient_data,
+            Outcome::Failed => self.failed,
+        }
+    }
+
+    /// Loops in all.
+    pub fn total(&self) -> usize {
+        Outcome::ALL.iter().map(|&o| self.get(o)).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn row(id: &str, verdict: Outcome, severity: f64) -> Row {
+        Row {
+            verdict,
+            severity,
+            ..Row::failed(id, "x.csv", String::new())
+        }
+    }
+
+    #[test]
+    fn severity_first_then_verdict_then_id() {
+        let mut rows = vec![
+            row("b", Outcome::Failed, 0.0),
+            row("a", Outcome::NoStiction, 0.0),
+            row("z", Outcome::Stiction, 0.5),
+            row("c", Outcome::Stiction, 2.0),
+            row("a2", Outcome::Stiction, 0.0),
+            row("b", Outcome::Undetermined, 0.0),
+        ];
+        rank(&mut rows);
+        let order: Vec<(&str, Outcome)> = rows
+            .iter()
+            .map(|r| (r.loop_id.as_str(), r.verdict))
+            .collect();
+        assert_eq!(
+            order,
+            [
+                ("c", Outcome::Stiction),
+                ("z", Outcome::Stiction),
+                ("a2", Outcome::Stiction),
+                ("b", Outcome::Undetermined),
+                ("a", Outcome::NoStiction),
+                ("b", Outcome::Failed),
+            ]
+        );
+    }
+
+    #[test]
+    fn outcome_names_are_serde_names() {
+        for o in Outcome::ALL {
+            assert_eq!(serde_json::to_string(&o).unwrap(), format!("\"{o}\""));
+        }
+        let c = Counts::of([Outcome::Failed, Outcome::Stiction, Outcome::Failed]);
+        assert_eq!((c.failed, c.stiction, c.total()), (2, 1, 3));
+    }
+
+    fn outcome() -> impl Strategy<Value = Outcome> {
+        (0usize..5).prop_map(|k| Outcome::ALL[k])
+    }
+
+    proptest! {
+        /// The ranking of a set of rows does not depend on the order they arrived in.
+        #[test]
+        fn ranking_is_independent_of_arrival_order(
+            rows in prop::collection::vec(("[a-d]{1,2}", outcome(), prop_oneof![Just(0.0), 0.0..3.0f64]), 0..20),
+            seed in any::<u64>(),
+        ) {
+            let rows: Vec<Row> = rows.iter().map(|(id, o, s)| row(id, *o, *s)).collect();
+            let mut a = rows.clone();
+            rank(&mut a);
+            // a deterministic shuffle of the same rows
+            let mut b = rows;
+            let mut state = seed | 1;
+            for i in (1..b.len()).rev() {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                b.swap(i, (state % (i as u64 + 1)) as usize);
+            }
+            rank(&mut b);
+            prop_assert_eq!(&a, &b);
+            // and it is sorted: severity never increases down the list
+            for w in a.windows(2) {
+                prop_assert!(w[0].severity >= w[1].severity);
+                prop_assert!(ranking(&w[0], &w[1]) != Ordering::Greater);
+            }
+        }
+    }
+}
