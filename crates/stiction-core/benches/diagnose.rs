@@ -3,7 +3,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use stiction_core::diagnose::{diagnose, DiagnoseRequest, LoopRecord};
 use stiction_core::models::{Model, Stenman};
-use stiction_core::sim::ClosedLoop;
+use stiction_core::sim::{ClosedLoop, Pi, Process};
 
 fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("diagnose");
@@ -19,6 +19,7 @@ fn benches(c: &mut Criterion) {
                 op: &data.op,
                 pv: &data.pv,
                 sp: Some(&data.sp),
+                mv: None,
                 time: Some(&data.t),
                 auto: None,
             };
@@ -34,6 +35,45 @@ fn benches(c: &mut Criterion) {
                 b.iter(|| diagnose(black_box(&rec), &indices_only).unwrap())
             });
         }
+    }
+    // the loop family's case (issue 14): a fast loop, Ts = 2 s, a 2 % band, a two-minute cycle
+    let mut cl = ClosedLoop::new(Model::Stenman(Stenman { d: 2.0 }));
+    cl.process = Process::Foptd {
+        k: 1.0,
+        tau: 12.0,
+        delay: 30.0,
+    };
+    cl.pi = Pi {
+        kc: 1.3,
+        ti: 1500.0,
+    };
+    cl.ts = 2.0;
+    cl.noise = 0.05;
+    cl.seed = 3;
+    cl.op0 = 41.5;
+    let data = cl.run().unwrap();
+    let rec = LoopRecord {
+        op: &data.op,
+        pv: &data.pv,
+        sp: Some(&data.sp),
+        mv: None,
+        time: Some(&data.t),
+        auto: None,
+    };
+    for quantify in [true, false] {
+        let req = DiagnoseRequest {
+            ts: 2.0,
+            quantify,
+            ..DiagnoseRequest::default()
+        };
+        let name = if quantify {
+            "fast_sticky_2000"
+        } else {
+            "fast_sticky_2000_without_quantify"
+        };
+        g.bench_function(name, |b| {
+            b.iter(|| diagnose(black_box(&rec), &req).unwrap())
+        });
     }
     g.finish();
 }

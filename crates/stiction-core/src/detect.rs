@@ -10,6 +10,26 @@
 
 use serde::{Deserialize, Serialize};
 
+/// What one index (or one family of evidence) says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Vote {
+    Stiction,
+    NoStiction,
+    Undetermined,
+}
+
+impl Vote {
+    /// +1 for stiction, -1 against, 0 undetermined.
+    pub fn sign(self) -> f64 {
+        match self {
+            Vote::Stiction => 1.0,
+            Vote::NoStiction => -1.0,
+            Vote::Undetermined => 0.0,
+        }
+    }
+}
+
 /// Thornhill's regularity of an oscillation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Regularity {
@@ -31,6 +51,32 @@ pub const REGULARITY_CAP: f64 = 1e6;
 
 /// Zero crossings of the autocorrelation used for the periods (about five periods).
 pub const MAX_CROSSINGS: usize = 11;
+
+/// The standard deviation of white measurement noise on `x`, robustly: the smaller of the
+/// estimates from first differences (MAD / 0.6745 / √2) and from second differences
+/// (MAD / 0.6745 / √6). Differences take slow variations off; first differences overstate the
+/// noise of a signal that moves a lot between samples (a ramp, a slow oscillation sampled fast),
+/// second differences that of a signal that moves fast between samples. White noise gives the
+/// same from both.
+pub fn measurement_noise(x: &[f64]) -> f64 {
+    let mad = |mut d: Vec<f64>| -> Option<f64> {
+        if d.is_empty() {
+            return None;
+        }
+        d.sort_by(f64::total_cmp);
+        Some(d[d.len() / 2] / 0.6745)
+    };
+    let d1 = mad(x.windows(2).map(|w| (w[1] - w[0]).abs()).collect());
+    let d2 = mad(x
+        .windows(3)
+        .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+        .collect());
+    match (d1, d2) {
+        (Some(a), Some(b)) => (a / 2f64.sqrt()).min(b / 6f64.sqrt()),
+        (Some(a), None) => a / 2f64.sqrt(),
+        _ => 0.0,
+    }
+}
 
 /// Autocorrelation of a mean-free copy of `x` for lags `0..=max_lag` (biased estimator, so r(0) = 1;
 /// all zeros for a constant). Computed by FFT.
@@ -157,8 +203,7 @@ pub struct CrossCorrelation {
     /// Odd (stiction) above `stiction_above`, even (no stiction) below `no_stiction_below`.
     pub stiction_above: f64,
     pub no_stiction_below: f64,
-    /// "stiction", "no_stiction" or "undetermined".
-    pub vote: String,
+    pub vote: Vote,
 }
 
 /// Cross-correlation of `op` with `pv` at lags `-max_lag..=max_lag` (index `max_lag` is lag 0;
@@ -195,9 +240,9 @@ pub fn horch(op: &[f64], pv: &[f64], ts: f64, max_lag: usize) -> CrossCorrelatio
     };
     let (hi, lo) = (2.0 / 3.0, 1.0 / 3.0);
     let vote = match oddness {
-        Some(o) if o > hi => "stiction",
-        Some(o) if o < lo => "no_stiction",
-        _ => "undetermined",
+        Some(o) if o > hi => Vote::Stiction,
+        Some(o) if o < lo => Vote::NoStiction,
+        _ => Vote::Undetermined,
     };
     CrossCorrelation {
         tau_left: left,
@@ -205,7 +250,7 @@ pub fn horch(op: &[f64], pv: &[f64], ts: f64, max_lag: usize) -> CrossCorrelatio
         oddness,
         stiction_above: hi,
         no_stiction_below: lo,
-        vote: vote.into(),
+        vote,
     }
 }
 
@@ -255,21 +300,20 @@ pub struct ShapeIndex {
     pub half_cycles: usize,
     pub stiction_above: f64,
     pub no_stiction_below: f64,
-    /// "stiction", "no_stiction" or "undetermined" (also when there are too few half cycles).
-    pub vote: String,
+    /// Undetermined also when there are too few half cycles.
+    pub vote: Vote,
 }
 
-fn vote(value: f64, half_cycles: usize, hi: f64, lo: f64) -> String {
+fn vote(value: f64, half_cycles: usize, hi: f64, lo: f64) -> Vote {
     if half_cycles < 4 || !value.is_finite() {
-        "undetermined"
+        Vote::Undetermined
     } else if value >= hi {
-        "stiction"
+        Vote::Stiction
     } else if value <= lo {
-        "no_stiction"
+        Vote::NoStiction
     } else {
-        "undetermined"
+        Vote::Undetermined
     }
-    .into()
 }
 
 /// Residual sum of squares of the least-squares fit `x ≈ a φ`.
@@ -433,11 +477,11 @@ mod tests {
         // PV a quarter period behind OP (integrating-like shape of a stick-slip cycle): odd
         let lagged: Vec<f64> = (0..n).map(|k| -(w * k as f64).cos()).collect();
         let odd = horch(&op, &lagged, 1.0, 60);
-        assert_eq!(odd.vote, "stiction", "{odd:?}");
+        assert_eq!(odd.vote, Vote::Stiction, "{odd:?}");
         // PV in antiphase with OP (a linear loop under a disturbance): even
         let anti: Vec<f64> = op.iter().map(|v| -v).collect();
         let even = horch(&op, &anti, 1.0, 60);
-        assert_eq!(even.vote, "no_stiction", "{even:?}");
+        assert_eq!(even.vote, Vote::NoStiction, "{even:?}");
         assert!((even.tau_right.unwrap() - 12.5).abs() < 0.5, "{even:?}");
     }
 
@@ -480,17 +524,17 @@ mod tests {
     #[test]
     fn curve_fitting_tells_triangles_from_sines() {
         let tri = curve_fitting_index(&wave(2000, 60.0, tri01, 0.05), 0.3);
-        assert_eq!(tri.vote, "stiction", "{tri:?}");
+        assert_eq!(tri.vote, Vote::Stiction, "{tri:?}");
         let sine = curve_fitting_index(&wave(2000, 60.0, sin01, 0.05), 0.3);
-        assert_eq!(sine.vote, "no_stiction", "{sine:?}");
+        assert_eq!(sine.vote, Vote::NoStiction, "{sine:?}");
     }
 
     #[test]
     fn shape_index_tells_squares_from_sines() {
         let square = shape_index(&wave(2000, 60.0, sq01, 0.05), 0.3);
-        assert_eq!(square.vote, "stiction", "{square:?}");
+        assert_eq!(square.vote, Vote::Stiction, "{square:?}");
         let sine = shape_index(&wave(2000, 60.0, sin01, 0.05), 0.3);
-        assert_eq!(sine.vote, "no_stiction", "{sine:?}");
+        assert_eq!(sine.vote, Vote::NoStiction, "{sine:?}");
     }
 
     #[test]

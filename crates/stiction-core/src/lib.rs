@@ -6,13 +6,16 @@
 pub mod detect;
 pub mod diagnose;
 pub mod estimate;
+pub mod fleet;
 pub mod identify;
+pub mod loop_analysis;
 pub mod models;
 pub mod quality;
 pub mod quantify;
 pub mod reproduce;
 pub mod rng;
 pub mod sim;
+pub mod sim_check;
 pub mod spectral;
 
 pub use estimate::{estimate, Estimate, Method, Request};

@@ -50,6 +50,8 @@ pub struct Record<'a> {
     pub op: &'a [f64],
     pub pv: &'a [f64],
     pub sp: Option<&'a [f64]>,
+    /// The recorded valve position, when there is one.
+    pub mv: Option<&'a [f64]>,
     /// Seconds, one per sample.
     pub time: Option<&'a [f64]>,
     /// `true` where the controller is in automatic.
@@ -63,6 +65,7 @@ impl<'a> Record<'a> {
             op: &self.op[start..end],
             pv: &self.pv[start..end],
             sp: self.sp.map(|v| &v[start..end]),
+            mv: self.mv.map(|v| &v[start..end]),
             time: self.time.map(|v| &v[start..end]),
             auto: self.auto.map(|v| &v[start..end]),
         }
@@ -202,6 +205,67 @@ pub fn time_gaps(t: &[f64], limits: &Limits) -> Finding {
     )
 }
 
+/// Samples that look not recorded: inside a run of at least `MIN_STRAIGHT` samples that lie on
+/// one straight line (repeated values are a flat line). Historians store a value only when it
+/// leaves a deviation band (deadband or swinging-door compression) and return repeated values or
+/// straight-line interpolation in between; a frozen transmitter repeats its last value. Measured
+/// signals carry noise, so a run of exactly straight samples is not a measurement.
+pub fn unrecorded(x: &[f64]) -> Vec<bool> {
+    let n = x.len();
+    let mut out = vec![false; n];
+    if n < MIN_STRAIGHT {
+        return out;
+    }
+    let mut d1: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
+    d1.sort_by(f64::total_cmp);
+    let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    // rounding of the export (a few decimals) bends a straight line by far less than noise does
+    let tol = 0.01 * d1[d1.len() / 2] + 1e-12 * scale;
+    let straight = |k: usize| (x[k + 1] - 2.0 * x[k] + x[k - 1]).abs() <= tol;
+    let mut k = 1;
+    while k + 1 < n {
+        if straight(k) {
+            let start = k;
+            while k + 1 < n && straight(k) {
+                k += 1;
+            }
+            // interior points k in [start, k) are straight: the run spans start-1 ..= k
+            if k - start + 2 >= MIN_STRAIGHT {
+                out[start - 1..=k].fill(true);
+            }
+        } else {
+            k += 1;
+        }
+    }
+    out
+}
+
+/// Runs of at least this many samples on one straight line count as not recorded.
+pub const MIN_STRAIGHT: usize = 5;
+
+/// The resolution of a quantised signal: the smallest step between consecutive samples, when at
+/// least a third of the steps are zero and every other step is a whole multiple of it.
+pub fn quantum(x: &[f64]) -> Option<f64> {
+    let steps: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
+    if steps.is_empty() {
+        return None;
+    }
+    let zeros = steps.iter().filter(|&&s| s == 0.0).count();
+    let q = steps
+        .iter()
+        .copied()
+        .filter(|&s| s > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if 3 * zeros < steps.len() || !q.is_finite() {
+        return None;
+    }
+    let whole = steps
+        .iter()
+        .filter(|&&s| s > 0.0)
+        .all(|&s| ((s / q) - (s / q).round()).abs() < 0.05);
+    whole.then_some(q)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -233,6 +297,7 @@ mod tests {
             op: &op,
             pv: &pv,
             sp: Some(&sp),
+            mv: None,
             time: Some(&t),
             auto: Some(&auto),
         };
@@ -265,6 +330,7 @@ mod tests {
             op: &op,
             pv: &pv,
             sp: Some(&sp),
+            mv: None,
             time: Some(&t),
             auto: Some(&auto),
         };
@@ -281,6 +347,45 @@ mod tests {
     }
 
     #[test]
+    fn straight_runs_and_repeats_are_not_recorded() {
+        // noise-like values, then a straight line, then repeats
+        // noise-like values (a linear congruential sequence), then a straight line, then repeats
+        let mut state = 12345u64;
+        let mut x: Vec<f64> = (0..40)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 33) as f64 / (1u64 << 31) as f64
+            })
+            .collect();
+        for (k, v) in x.iter_mut().enumerate().take(20).skip(10) {
+            *v = 3.0 + 0.25 * (k - 10) as f64;
+        }
+        for v in &mut x[25..32] {
+            *v = 9.0;
+        }
+        let u = unrecorded(&x);
+        assert!(u[10..20].iter().all(|&b| b), "{u:?}");
+        assert!(u[25..32].iter().all(|&b| b), "{u:?}");
+        assert!(!u[0..8].iter().any(|&b| b), "{u:?}");
+        assert!(!u[34..].iter().any(|&b| b), "{u:?}");
+    }
+
+    #[test]
+    fn the_quantum_of_a_quantised_signal() {
+        let x: Vec<f64> = (0..200)
+            .map(|k| (((k as f64) * 0.05).sin() * 20.0).round() * 0.5)
+            .collect();
+        let q = quantum(&x).unwrap();
+        assert!((q - 0.5).abs() < 1e-12, "{q}");
+        let noisy: Vec<f64> = (0..200)
+            .map(|k| ((k * 7919) % 101) as f64 * 0.013)
+            .collect();
+        assert_eq!(quantum(&noisy), None);
+    }
+
+    #[test]
     fn a_quantised_pv_is_caught() {
         let (op, pv) = loop_record(1000);
         let coarse: Vec<f64> = pv.iter().map(|v| v.round()).collect();
@@ -288,6 +393,7 @@ mod tests {
             op: &op,
             pv: &coarse,
             sp: None,
+            mv: None,
             time: None,
             auto: None,
         };

@@ -1,6 +1,6 @@
-//! The diagnosis: gates before verdicts, oscillation first, the indices' votes, windows.
+//! The diagnosis: usable stretches, the families of evidence, the verdict, windows.
 
-use stiction_core::diagnose::{diagnose, DiagnoseRequest, LoopRecord, Verdict, Vote};
+use stiction_core::diagnose::{diagnose, DiagnoseRequest, Family, LoopRecord, Verdict, Vote};
 use stiction_core::models::{Model, Stenman};
 use stiction_core::sim::{ClosedLoop, LoopData, Process, Signal};
 
@@ -18,6 +18,7 @@ fn record(l: &LoopData) -> LoopRecord<'_> {
         op: &l.op,
         pv: &l.pv,
         sp: Some(&l.sp),
+        mv: None,
         time: Some(&l.t),
         auto: None,
     }
@@ -51,7 +52,7 @@ fn sticky_healthy_and_disturbed_loops() {
     let sticky = run(2.0, |_| {});
     let d = diagnose(&record(&sticky), &DiagnoseRequest::default()).unwrap();
     assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
-    let band = d.apparent_stiction.unwrap().closed_loop.unwrap();
+    let band = d.band.unwrap().band_percent_of_span;
     assert!((band - 2.0).abs() < 0.5, "band {band}");
     assert!(d.oscillation.unwrap().oscillating);
     for i in &d.indices {
@@ -70,7 +71,7 @@ fn sticky_healthy_and_disturbed_loops() {
 }
 
 #[test]
-fn a_failed_gate_is_never_a_verdict() {
+fn unusable_samples_are_left_out_and_gaps_split_the_record() {
     let sticky = run(2.0, |_| {});
     // every sample in manual
     let auto = vec![false; sticky.op.len()];
@@ -85,26 +86,30 @@ fn a_failed_gate_is_never_a_verdict() {
     r.op = &op;
     let d = diagnose(&r, &quick()).unwrap();
     assert_eq!(d.verdict, Verdict::InsufficientData);
-    // a frozen (compressed) PV
-    let pv: Vec<f64> = sticky.pv.iter().map(|v| (v * 0.2).round() / 0.2).collect();
-    let mut r = record(&sticky);
-    r.pv = &pv;
-    let d = diagnose(&r, &quick()).unwrap();
-    assert_eq!(d.verdict, Verdict::InsufficientData, "{:?}", d.reason);
-    // a gap in time
+    // a gap in time splits the record; the longer stretch is judged
     let mut t = sticky.t.clone();
-    for v in &mut t[1000..] {
+    for v in &mut t[1200..] {
         *v += 500.0;
     }
     let mut r = record(&sticky);
     r.time = Some(&t);
     let d = diagnose(&r, &quick()).unwrap();
-    assert_eq!(d.verdict, Verdict::InsufficientData);
-    assert!(d.reason.unwrap().contains("gaps"));
+    assert_eq!(d.stretches, vec![[0, 1200], [1200, 2000]]);
+    assert_eq!(d.analysed, [0, 1200]);
+    assert!(d.quality.iter().any(|f| f.gate == "time_gaps" && !f.passed));
+    assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
+    // missing values (NaN) split it too
+    let mut pv = sticky.pv.clone();
+    pv[300] = f64::NAN;
+    let mut r = record(&sticky);
+    r.pv = &pv;
+    let d = diagnose(&r, &quick()).unwrap();
+    assert_eq!(d.stretches, vec![[0, 300], [301, 2000]]);
+    assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
 }
 
 #[test]
-fn manual_stretches_and_setpoint_changes_are_left_out() {
+fn manual_stretches_are_left_out_and_setpoint_changes_kept() {
     let sticky = run(2.0, |_| {});
     let n = sticky.op.len();
     let auto: Vec<bool> = (0..n).map(|k| k >= 400).collect();
@@ -113,23 +118,24 @@ fn manual_stretches_and_setpoint_changes_are_left_out() {
     let d = diagnose(&r, &quick()).unwrap();
     assert_eq!(d.analysed, [400, n]);
     assert_eq!(d.verdict, Verdict::Stiction);
-    // the default setpoint steps at 10 s: the stretch after it is analysed
+    // the default setpoint steps at 10 s: the whole record is analysed
     let d = diagnose(&record(&sticky), &quick()).unwrap();
-    assert_eq!(d.analysed, [10, n]);
+    assert_eq!(d.analysed, [0, n]);
 }
 
 #[test]
-fn too_short_for_its_oscillation_is_insufficient_not_healthy() {
+fn too_short_for_its_oscillation_is_never_healthy() {
     let sticky = run(2.0, |_| {});
     let r = LoopRecord {
         op: &sticky.op[500..700],
         pv: &sticky.pv[500..700],
         sp: None,
+        mv: None,
         time: None,
         auto: None,
     };
     let d = diagnose(&r, &quick()).unwrap();
-    assert_eq!(d.verdict, Verdict::InsufficientData, "{:?}", d.reason);
+    assert_ne!(d.verdict, Verdict::NoStiction, "{:?}", d.evidence);
 }
 
 #[test]
@@ -143,10 +149,20 @@ fn windows_cover_the_record_and_bad_requests_are_errors() {
     assert_eq!(d.windows.len(), 3);
     assert_eq!(d.windows[0].start, 0);
     assert_eq!(d.windows[2].end, 3000);
+    // a 1000-sample window of a regular limit cycle can leave every family undecided (the
+    // linear loop fits it at its stability limit): never `no_stiction`, never short of data
+    let mut called = 0;
     for w in &d.windows {
-        assert_eq!(w.verdict, Verdict::Stiction, "{w:?}");
-        assert!(w.votes.iter().any(|v| v.1 == Vote::Stiction));
+        assert!(
+            matches!(w.verdict, Verdict::Stiction | Verdict::Undetermined),
+            "{w:?}"
+        );
+        if w.verdict == Verdict::Stiction {
+            assert!(w.votes.iter().any(|v| v.1 == Vote::Stiction), "{w:?}");
+            called += 1;
+        }
     }
+    assert!(called >= 2, "{:?}", d.windows);
     let bad = DiagnoseRequest {
         window: Some(5),
         ..quick()
@@ -237,28 +253,22 @@ fn an_oscillation_that_op_does_not_drive_is_not_stiction() {
         op: &op,
         pv: &pv,
         sp: None,
+        mv: None,
         time: None,
         auto: None,
     };
-    let without = diagnose(&rec, &quick()).unwrap();
-    let with = diagnose(&rec, &DiagnoseRequest::default()).unwrap();
-    assert_eq!(
-        without.verdict,
-        Verdict::Stiction,
-        "{:#?}",
-        without.evidence
-    );
-    assert_eq!(with.verdict, Verdict::NoStiction, "{:#?}", with.evidence);
+    let d = diagnose(&rec, &DiagnoseRequest::default()).unwrap();
+    assert_ne!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
+    let model = d
+        .families
+        .iter()
+        .find(|f| f.family == Family::Model)
+        .unwrap();
+    assert_eq!(model.vote, Vote::NoStiction, "{model:#?}");
     assert!(
-        with.reason
-            .as_deref()
-            .unwrap()
-            .contains("enters the loop elsewhere"),
-        "{:?}",
-        with.reason
+        model.note.contains("enters the loop elsewhere"),
+        "{}",
+        model.note
     );
-    assert!(with.apparent_stiction.is_none());
-    let check = with.closed_loop_check.unwrap();
-    assert!(!check.passed && check.explained < check.limit, "{check:?}");
-    assert!(without.closed_loop_check.is_none());
+    assert!(d.band.is_none());
 }

@@ -1,0 +1,173 @@
+//! What the loop family measures: the identified loop, the observed cycle, and the valve whose
+//! describing function closes the harmonic balance.
+
+use super::{
+    DescribingBand, LoopEvidence, ProcessSource, CALIBRATION, LIMIT_NEAR, MIN_PI_R2, PERIOD_MATCH,
+    PI_CUTOFF,
+};
+use crate::diagnose::evidence::Context;
+use crate::loop_analysis::cycle::share;
+use crate::loop_analysis::describing::{harmonic_balance, nearest, valve_loci, ValveLocus};
+use crate::loop_analysis::frequency::pi_response;
+use crate::loop_analysis::{identify_pi_below, AmplitudeTrend, Complex64, Cycles, OpenLoop};
+use crate::spectral::harmonic_distortion;
+use std::f64::consts::PI;
+
+/// Everything the vote reads, or why the family cannot judge.
+pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
+    let osc = &ctx.oscillation;
+    let periods = osc.periods_in_record.unwrap_or(0.0);
+    let period = match osc.period {
+        Some(p) if osc.oscillating && periods >= ctx.req.min_periods => p,
+        _ => {
+            return Err(if osc.oscillating {
+                format!("only {periods:.1} oscillation periods with a constant setpoint; the loop family needs {}", ctx.req.min_periods)
+            } else {
+                "no oscillation above the noise: a loop that does not cycle has no limit cycle to explain".into()
+            })
+        }
+    };
+    let Some(fits) = &ctx.fits else {
+        return Err("no process model could be fitted from OP to PV".into());
+    };
+    let (process, source) = match (&fits.stiction_model, &fits.linear_model) {
+        (Some(f), _) if f.stable() => (f, ProcessSource::StictionFit),
+        (_, Some(f)) => (f, ProcessSource::LinearFit),
+        _ => return Err("no stable process model could be fitted from OP to PV".into()),
+    };
+    let ts = ctx.req.ts;
+    // the controller's law below a few times the cycle's frequency, where the loop cycles
+    let Some(pi) = identify_pi_below(ctx.op, &ctx.error, ts, PI_CUTOFF * ts / period) else {
+        return Err("OP or the control error does not move: no controller to identify".into());
+    };
+    let caveat = ctx.sp.is_none().then(|| {
+        "no setpoint recorded: the error is taken as the PV's deviation from its mean; the inner loop of a cascade, whose setpoint moves with the outer loop, \
+         would weaken this evidence".to_string()
+    });
+    if pi.r2 < MIN_PI_R2 {
+        return Err(format!(
+            "OP does not follow a PI law of the {} (R² {:.2} of its increments){}",
+            if ctx.sp.is_some() {
+                "control error"
+            } else {
+                "PV (no setpoint recorded: a cascade's moving setpoint?)"
+            },
+            pi.r2,
+            ""
+        ));
+    }
+    let [s, e] = osc.stretch;
+    let (op, pv) = (&ctx.op[s..e], &ctx.pv[s..e]);
+    let Some(cycles) = Cycles::find(op, period / ts) else {
+        return Err("fewer than 4 whole cycles of OP to measure".into());
+    };
+    let period = cycles.period() * ts;
+    let theta = 2.0 * PI * ts / period;
+    let op_c = cycles.coefficients(op);
+    let pv_c = cycles.coefficients(pv);
+    let sim = &fits.pv_stiction;
+    let residual: Vec<f64> = if sim.len() == ctx.pv.len() {
+        pv.iter().zip(&sim[s..e]).map(|(a, b)| a - b).collect()
+    } else {
+        pv.to_vec()
+    };
+    let residual_share = share(&cycles.coefficients(&residual), &pv_c);
+    // what the PI makes of the error's cycles, against OP's
+    let unexplained: Vec<(f64, Complex64)> = cycles
+        .coefficients(&ctx.error[s..e])
+        .iter()
+        .zip(&op_c)
+        .map(|(&(th, e1), &(_, o1))| (th, o1 - pi_response(&pi, th) * e1))
+        .collect();
+    let controller_residual_share = share(&unexplained, &op_c);
+    let amps: Vec<f64> = op_c.iter().map(|(_, z)| z.norm()).collect();
+    let amplitude = AmplitudeTrend::of(&amps);
+    let op_amplitude = amps.iter().sum::<f64>() / amps.len() as f64;
+    let pv_amplitude = pv_c.iter().map(|(_, z)| z.norm()).sum::<f64>() / pv_c.len() as f64;
+    let harmonics = [op, pv]
+        .iter()
+        .filter_map(|x| harmonic_distortion(x, 1.0 / cycles.period(), 5))
+        .reduce(f64::max);
+    let open = OpenLoop { process, pi: &pi };
+    let margins = open.margins(theta / 20.0, ts);
+    let needed = -1.0 / open.response(theta);
+    let describing = describing_band(ctx, &open, needed, period, op_amplitude);
+    Ok(LoopEvidence {
+        controller: pi.clone(),
+        setpoint_recorded: ctx.sp.is_some(),
+        process: source,
+        margins,
+        period,
+        op_amplitude,
+        pv_amplitude,
+        harmonics,
+        residual_share,
+        controller_residual_share,
+        op_at_limit: at_limit(op, period / ts, ctx.req.op_range),
+        amplitude,
+        needed_gain: needed.norm(),
+        needed_lag_degrees: -needed.arg().to_degrees(),
+        describing,
+        caveat,
+        calibration: CALIBRATION.into(),
+    })
+}
+
+/// Share of the cycles whose OP comes within [`LIMIT_NEAR`] of the range's ends (the analysed
+/// stretch leaves out the samples at a limit, so their neighbours show it).
+fn at_limit(op: &[f64], period: f64, [lo, hi]: [f64; 2]) -> f64 {
+    // an OP outside the range is in other units (normalised, engineering): its limits are not
+    // the range's (as the usable-stretch rule decides)
+    if op.iter().any(|v| *v < lo || *v > hi) {
+        return 0.0;
+    }
+    let w = period.round().max(2.0) as usize;
+    let near = LIMIT_NEAR * (hi - lo);
+    let chunks: Vec<&[f64]> = op.chunks(w).filter(|c| c.len() * 2 >= w).collect();
+    let hit = chunks
+        .iter()
+        .filter(|c| c.iter().any(|v| *v <= lo + near || *v >= hi - near))
+        .count();
+    hit as f64 / chunks.len().max(1) as f64
+}
+
+/// The valve describing function nearest `needed`, its band for the observed OP amplitude, and the
+/// period its harmonic balance with the identified loop predicts.
+fn describing_band(
+    ctx: &Context,
+    open: &OpenLoop,
+    needed: Complex64,
+    period: f64,
+    op_amplitude: f64,
+) -> Option<DescribingBand> {
+    let ts = ctx.req.ts;
+    let loci = valve_loci(period / ts);
+    let near = nearest(&loci, needed)?;
+    let band = op_amplitude / near.ratio;
+    let theta0 = 2.0 * PI * ts / period;
+    let locus: Vec<&ValveLocus> = loci
+        .iter()
+        .filter(|l| l.kind == near.kind && l.slip_ratio == near.slip_ratio)
+        .collect();
+    let predicted = locus.first().and_then(|l| {
+        harmonic_balance(&open.nyquist(theta0 / 20.0), &l.points)
+            .into_iter()
+            .min_by(|a, b| {
+                (a.theta / theta0)
+                    .ln()
+                    .abs()
+                    .total_cmp(&(b.theta / theta0).ln().abs())
+            })
+            .map(|b| 2.0 * PI * ts / b.theta)
+    });
+    Some(DescribingBand {
+        model: near.kind,
+        slip_ratio: near.slip_ratio,
+        band,
+        band_percent_of_span: ctx.req.percent_of_span(band),
+        amplitude_over_band: near.ratio,
+        distance: near.distance,
+        predicted_period: predicted,
+        period_matches: predicted.is_some_and(|p| (p / period).ln().abs() <= PERIOD_MATCH.ln()),
+    })
+}

@@ -1,0 +1,148 @@
+//! Families of evidence: independent ways of asking "is the valve sticky?", each behind one small
+//! trait so that a new family is one new file. Each returns typed evidence: its statistic, the
+//! threshold it is held to (in words), its vote and how strongly it holds it.
+//!
+//! - [`shape`]: the shape of an oscillation (the literature's indices), on oscillating stretches;
+//! - [`model`]: the closed-loop Hammerstein fit with and without stiction, on the whole record;
+//! - [`stick_slip`]: episodes of OP travelling while PV stays put, ended by a PV jump;
+//! - [`valve`]: the recorded valve position against OP, when MV is recorded;
+//! - [`limit_cycle`]: a limit cycle that no linear loop can sustain (the identified loop, its
+//!   margin and the describing function of a band).
+
+pub mod limit_cycle;
+pub mod model;
+pub mod shape;
+pub mod stick_slip;
+pub mod valve;
+
+use super::request::DiagnoseRequest;
+use super::result::{Oscillation, Vote};
+use crate::quantify::FitComparison;
+use serde::{Deserialize, Serialize};
+
+pub use limit_cycle::LoopEvidence;
+pub use model::ModelEvidence;
+pub use stick_slip::StickSlipEvidence;
+pub use valve::ValveEvidence;
+
+/// The families of evidence.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Family {
+    Shape,
+    Model,
+    StickSlip,
+    Valve,
+    /// The identified loop and its limit cycle.
+    Loop,
+}
+
+impl Family {
+    /// The name used in files (`stick_slip`), as serde writes it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Family::Shape => "shape",
+            Family::Model => "model",
+            Family::StickSlip => "stick_slip",
+            Family::Valve => "valve",
+            Family::Loop => "loop",
+        }
+    }
+
+    /// The family's name in words.
+    pub fn words(self) -> &'static str {
+        match self {
+            Family::Shape => "shape of the oscillation",
+            Family::Model => "closed-loop fit",
+            Family::StickSlip => "stick-slip episodes",
+            Family::Valve => "valve position",
+            Family::Loop => "linear loop",
+        }
+    }
+}
+
+/// What one family found.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FamilyEvidence {
+    pub family: Family,
+    pub vote: Vote,
+    /// 0..1: how strongly the evidence holds the vote (1: decisive; for `undetermined`, 0).
+    pub strength: f64,
+    /// The family's statistic.
+    pub value: Option<f64>,
+    /// What the statistic is, in words.
+    pub statistic: String,
+    /// The rule it is held to, in words.
+    pub threshold: String,
+    /// Why it voted as it did, or why it could not vote.
+    pub note: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<ModelEvidence>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stick_slip: Option<StickSlipEvidence>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub valve: Option<ValveEvidence>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limit_cycle: Option<LoopEvidence>,
+}
+
+impl FamilyEvidence {
+    /// A family that cannot judge this record.
+    pub fn abstains(family: Family, statistic: &str, threshold: String, note: String) -> Self {
+        Self {
+            family,
+            vote: Vote::Undetermined,
+            strength: 0.0,
+            value: None,
+            statistic: statistic.into(),
+            threshold,
+            note,
+            model: None,
+            stick_slip: None,
+            valve: None,
+            limit_cycle: None,
+        }
+    }
+}
+
+/// Everything the families read: the analysed stretch and what is computed once for all.
+pub struct Context<'a> {
+    pub req: &'a DiagnoseRequest,
+    pub op: &'a [f64],
+    pub pv: &'a [f64],
+    pub sp: Option<&'a [f64]>,
+    pub mv: Option<&'a [f64]>,
+    /// The control error (SP - PV, or the PV's deviation from its mean without SP).
+    pub error: Vec<f64>,
+    /// The oscillation on the longest constant-setpoint stretch (indices relative to `op`).
+    pub oscillation: Oscillation,
+    /// Robust noise standard deviations of PV and OP (from first differences).
+    pub pv_noise: f64,
+    pub op_noise: f64,
+    /// The PV's resolution when it is quantised.
+    pub pv_quantum: Option<f64>,
+    /// PV samples that look not recorded: inside runs of repeated values or of exactly straight
+    /// lines (historian compression, a frozen transmitter).
+    pub unrecorded: Vec<bool>,
+    /// The closed-loop fits with and without stiction (`None` when no linear model fits).
+    pub fits: Option<FitComparison>,
+    /// The shape family's indices, once computed (they go to [`super::Diagnosis::indices`]).
+    pub indices: std::cell::OnceCell<Vec<super::result::Index>>,
+}
+
+/// One family of evidence.
+pub trait EvidenceFamily {
+    fn family(&self) -> Family;
+    fn evaluate(&self, ctx: &Context) -> FamilyEvidence;
+}
+
+/// Every family, in the order they are reported.
+pub fn all() -> [&'static dyn EvidenceFamily; 5] {
+    [
+        &valve::Valve,
+        &model::Model,
+        &stick_slip::StickSlip,
+        &shape::Shape,
+        &limit_cycle::LimitCycle,
+    ]
+}

@@ -1,0 +1,186 @@
+//! Diagnosing a loop from routine data, as a control engineer does: which samples can be judged
+//! (automatic mode, every signal present, OP off its limits; setpoint changes are kept, they are
+//! the best excitation a loop gets), then independent families of evidence, each with its value,
+//! threshold and vote, and a verdict that says why.
+//!
+//! - [`stretch`] and [`gates`]: the usable stretches and the data-quality findings;
+//! - [`oscillation`]: does the loop oscillate (for the shape family);
+//! - [`evidence`]: the families (shape, model, stick-slip, valve), one file each behind a trait;
+//! - [`verdict`]: families that agree decide, families that conflict give `undetermined`;
+//! - [`band`]: when the verdict is `stiction`, the band in % of valve span and where it comes from;
+//! - [`windows`]: the same judgement per window of the record.
+
+mod band;
+pub mod evidence;
+mod gates;
+pub mod oscillation;
+mod request;
+mod result;
+mod stretch;
+mod verdict;
+mod windows;
+
+pub use evidence::{Family, FamilyEvidence};
+pub use oscillation::noise_std;
+pub use request::{DiagnoseError, DiagnoseRequest};
+pub use result::{Band, BandSource, Diagnosis, Index, Oscillation, Verdict, Vote, WindowVerdict};
+
+/// The signals of one loop record (op, pv, and when recorded sp, mv, time in seconds, and
+/// `auto`: `true` where the controller is in automatic). Missing values are NaN.
+pub use crate::quality::Record as LoopRecord;
+
+use crate::quality::{self, Finding};
+use crate::quantify::{compare_fits, CompareRequest};
+use evidence::Context;
+use oscillation::{constant_setpoint, mean};
+use result::Oscillation as Osc;
+use std::time::Instant;
+
+/// One stretch judged: the families, the shape indices, the oscillation and the decision.
+struct Judged {
+    families: Vec<FamilyEvidence>,
+    indices: Vec<Index>,
+    oscillation: Osc,
+    decision: verdict::Decision,
+    fits: Option<crate::quantify::FitComparison>,
+}
+
+/// The control error: SP - PV, or without a setpoint the PV's deviation from its mean.
+fn control_error(pv: &[f64], sp: Option<&[f64]>) -> Vec<f64> {
+    match sp {
+        Some(sp) => sp.iter().zip(pv).map(|(a, b)| a - b).collect(),
+        None => {
+            let m = mean(pv);
+            pv.iter().map(|v| m - v).collect()
+        }
+    }
+}
+
+/// Judge one usable stretch (every sample present, automatic).
+fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
+    let error = control_error(r.pv, r.sp);
+    let (os, oe) = constant_setpoint(r.sp, (0, r.op.len()));
+    let oscillation = oscillation::oscillation(&error[os..oe], req.ts, (os, oe));
+    let compare = CompareRequest {
+        ts: req.ts,
+        max_delay: req.max_delay,
+        integrating: Some(req.integrating),
+    };
+    let ctx = Context {
+        req,
+        op: r.op,
+        pv: r.pv,
+        sp: r.sp,
+        mv: r.mv,
+        error,
+        oscillation,
+        pv_noise: crate::detect::measurement_noise(r.pv),
+        op_noise: crate::detect::measurement_noise(r.op),
+        pv_quantum: quality::quantum(r.pv),
+        unrecorded: quality::unrecorded(r.pv),
+        fits: compare_fits(r.op, r.pv, &compare),
+        indices: Default::default(),
+    };
+    let families: Vec<FamilyEvidence> = evidence::all().iter().map(|f| f.evaluate(&ctx)).collect();
+    let decision = verdict::decide(&families, ctx.oscillation.oscillating);
+    let Context {
+        oscillation,
+        indices,
+        fits,
+        ..
+    } = ctx;
+    Judged {
+        families,
+        indices: indices.into_inner().unwrap_or_default(),
+        oscillation,
+        decision,
+        fits,
+    }
+}
+
+/// Diagnose one loop.
+pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, DiagnoseError> {
+    let started = Instant::now();
+    request::check(r, req)?;
+    let n = r.op.len();
+    let (stretches, excluded) = stretch::usable(r, req);
+    let (s, e) = stretches
+        .iter()
+        .copied()
+        .max_by_key(|&(a, b)| (b - a, std::cmp::Reverse(a)))
+        .unwrap_or((0, 0));
+    let quality = gates::findings(r, (s, e), stretches.len(), &excluded, req);
+    let mut warnings = Vec::new();
+    if r.sp.is_none() {
+        warnings.push(
+            "no setpoint column: the control error is taken as the PV's deviation from its mean"
+                .into(),
+        );
+    }
+    let windows = req
+        .window
+        .map_or_else(Vec::new, |w| windows::judge_windows(r, req, w, judge));
+    let mut d = Diagnosis {
+        verdict: Verdict::InsufficientData,
+        confidence: None,
+        reason: None,
+        evidence: Vec::new(),
+        next_step: String::new(),
+        samples: n,
+        analysed: [s, e],
+        stretches: stretches.iter().map(|&(a, b)| [a, b]).collect(),
+        ts: req.ts,
+        quality,
+        oscillation: None,
+        families: Vec::new(),
+        indices: Vec::new(),
+        band: None,
+        quantification: None,
+        quantified: None,
+        windows,
+        warnings,
+        seconds: 0.0,
+    };
+    if e - s < req.min_samples {
+        let reason = too_short(&d.quality, e - s, req);
+        d.evidence = vec![reason.clone()];
+        d.reason = Some(reason);
+        d.next_step = "use a longer record in automatic with every signal present".into();
+        d.seconds = started.elapsed().as_secs_f64();
+        return Ok(d);
+    }
+    let sub = r.slice(s, e);
+    let j = judge(&sub, req);
+    d.verdict = j.decision.verdict;
+    d.confidence = j.decision.confidence;
+    d.reason = j.decision.reason;
+    d.evidence = j.decision.evidence;
+    d.next_step = j.decision.next_step;
+    d.families = j.families;
+    d.indices = j.indices;
+    let mut osc = j.oscillation;
+    osc.stretch = [osc.stretch[0] + s, osc.stretch[1] + s];
+    if d.verdict == Verdict::Stiction {
+        band::size(&mut d, &sub, s, &osc, j.fits.as_ref(), req);
+    }
+    d.oscillation = Some(osc);
+    d.seconds = started.elapsed().as_secs_f64();
+    Ok(d)
+}
+
+/// Why a record too short to judge is so.
+fn too_short(quality: &[Finding], used: usize, req: &DiagnoseRequest) -> String {
+    let left: Vec<&str> = quality
+        .iter()
+        .filter(|f| !f.passed && f.gate != "record_length" && f.gate != "pv_quantised")
+        .map(|f| f.message.as_str())
+        .collect();
+    let mut reason = format!(
+        "the longest usable stretch has {used} samples; a verdict needs at least {}",
+        req.min_samples
+    );
+    if !left.is_empty() {
+        reason.push_str(&format!(" ({})", left.join("; ")));
+    }
+    reason
+}

@@ -1,0 +1,204 @@
+//! The diagnosis of one loop, shared by every front end (CLI, report, batch, Python).
+
+use super::evidence::FamilyEvidence;
+use crate::detect::{IaeCount, Regularity};
+use crate::quality::Finding;
+use crate::quantify::Quantification;
+use serde::{Deserialize, Serialize};
+
+pub use crate::detect::Vote;
+
+/// The answer for a loop.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    Stiction,
+    NoStiction,
+    Undetermined,
+    InsufficientData,
+}
+
+impl Verdict {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Stiction => "stiction",
+            Verdict::NoStiction => "no_stiction",
+            Verdict::Undetermined => "undetermined",
+            Verdict::InsufficientData => "insufficient_data",
+        }
+    }
+}
+
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// One stiction index of the shape family: its value, the threshold it is held to, and its vote.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Index {
+    /// Short name: "cross_correlation", "ddpv_histogram", "bicoherence", "curve_fitting",
+    /// "harmonics", "shape".
+    pub name: String,
+    /// Where the method and its threshold come from.
+    pub reference: String,
+    pub value: Option<f64>,
+    /// The rule, in words, e.g. "stiction above 0.667, none below 0.333".
+    pub threshold: String,
+    pub vote: Vote,
+    /// Its weight in the shape family's vote.
+    pub weight: f64,
+    /// Set for an index that can vote only one way (the shape index confirms stiction, the
+    /// harmonics index confirms a linear oscillation): when it does not cast that vote it is
+    /// silent by design and is left out of the family's total weight, so its silence does not
+    /// dilute the other indices.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub only_votes: Option<Vote>,
+    /// Why it voted as it did, or why it could not vote.
+    pub note: String,
+}
+
+/// Is there an oscillation, and of what period?
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Oscillation {
+    pub oscillating: bool,
+    /// Seconds.
+    pub period: Option<f64>,
+    /// Stretch length over the period.
+    pub periods_in_record: Option<f64>,
+    pub regularity: Regularity,
+    pub iae: IaeCount,
+    /// Standard deviation of the noise on the control error (robust, from first differences).
+    pub noise_std: f64,
+    /// Half the peak-to-peak amplitude of the control error (5th to 95th percentile).
+    pub amplitude: f64,
+    /// The samples `[start, end)` the oscillation was judged on (the longest stretch with a
+    /// constant setpoint).
+    pub stretch: [usize; 2],
+}
+
+/// Where the band in the verdict comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BandSource {
+    /// Estimated from OP and the recorded valve position (the paper's problem, exact).
+    Valve,
+    /// The closed-loop Hammerstein estimate (Stenman, exact) from OP and PV.
+    ClosedLoop,
+    /// The closed-loop fit's scan of the Stenman band (not the exact search).
+    FitScan,
+    /// The median OP travel per stick of the stick-slip episodes.
+    StickSlip,
+    /// The band whose describing function closes the harmonic balance of the identified loop at
+    /// the observed cycle (the loop family).
+    DescribingFunction,
+}
+
+impl BandSource {
+    /// Where the band comes from, in words.
+    pub fn words(self) -> &'static str {
+        match self {
+            BandSource::Valve => "from the recorded valve position",
+            BandSource::ClosedLoop => "the closed-loop estimate (Stenman, exact)",
+            BandSource::FitScan => "the closed-loop fit's scan of the Stenman band",
+            BandSource::StickSlip => "the median OP travel per stick",
+            BandSource::DescribingFunction => "the describing function of the loop's limit cycle",
+        }
+    }
+}
+
+impl BandSource {
+    /// The name used in files (`closed_loop`), as serde writes it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            BandSource::Valve => "valve",
+            BandSource::ClosedLoop => "closed_loop",
+            BandSource::FitScan => "fit_scan",
+            BandSource::StickSlip => "stick_slip",
+            BandSource::DescribingFunction => "describing_function",
+        }
+    }
+}
+
+/// The stiction band the verdict reports.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Band {
+    /// In % of valve span (OP mapped through the request's `op_range`).
+    pub band_percent_of_span: f64,
+    /// In OP units.
+    pub op_units: f64,
+    /// The values that fit equally well, % of span, where the source knows them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interval_percent_of_span: Option<[f64; 2]>,
+    pub source: BandSource,
+    /// The other estimates, % of span, for comparison.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub others: Vec<(BandSource, f64)>,
+    /// The width along OP of the ellipse fitted to the filtered PV-OP plot of an oscillation
+    /// (Choudhury et al. 2008), % of span.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ellipse_percent_of_span: Option<f64>,
+}
+
+/// The verdict for one window of the record.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WindowVerdict {
+    /// Sample range `[start, end)` in the whole record.
+    pub start: usize,
+    pub end: usize,
+    /// Time of the first and last sample, seconds.
+    pub t_start: f64,
+    pub t_end: f64,
+    pub verdict: Verdict,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub confidence: Option<f64>,
+    pub reason: Option<String>,
+    pub period: Option<f64>,
+    /// Each family's vote.
+    pub votes: Vec<(super::evidence::Family, Vote)>,
+}
+
+/// The diagnosis of one loop.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Diagnosis {
+    pub verdict: Verdict,
+    /// 0..1, for `stiction` and `no_stiction` only: how strongly the families that decided agree.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub confidence: Option<f64>,
+    /// For `insufficient_data` and `undetermined`: the reason (for a conflict, the families that
+    /// disagree).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// The findings behind the verdict, in words.
+    pub evidence: Vec<String>,
+    /// What to do next, in one line.
+    pub next_step: String,
+    pub samples: usize,
+    /// The analysed stretch `[start, end)`: the longest stretch in automatic with usable data
+    /// (setpoint changes are kept: they excite the loop).
+    pub analysed: [usize; 2],
+    /// Every usable stretch, the analysed one among them.
+    pub stretches: Vec<[usize; 2]>,
+    pub ts: f64,
+    pub quality: Vec<Finding>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub oscillation: Option<Oscillation>,
+    /// The families of evidence, each with its value, threshold and vote.
+    pub families: Vec<FamilyEvidence>,
+    /// The shape family's indices (on an oscillating stretch).
+    pub indices: Vec<Index>,
+    /// The stiction band, when the verdict is `stiction`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub band: Option<Band>,
+    /// The closed-loop estimate (`quantify`, Stenman exact) behind the band.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quantification: Option<Quantification>,
+    /// The samples `[start, end)` the closed-loop estimate used.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quantified: Option<[usize; 2]>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub windows: Vec<WindowVerdict>,
+    pub warnings: Vec<String>,
+    pub seconds: f64,
+}

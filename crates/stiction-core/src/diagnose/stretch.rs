@@ -1,0 +1,163 @@
+//! The usable stretches of a record: samples in automatic, with every signal present, OP off its
+//! limits, and a time axis without gaps. Setpoint changes do not split a stretch: they are the best
+//! excitation a loop gets.
+
+use super::request::DiagnoseRequest;
+use crate::quality::Record;
+
+/// Why samples were left out, counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct Excluded {
+    pub manual: usize,
+    pub missing: usize,
+    pub saturated: usize,
+    /// Breaks of the time axis (gaps longer than the limit, or time not increasing).
+    pub time_breaks: usize,
+}
+
+/// Runs of at least this many equal OP values at the record's own extreme count as OP held at a
+/// limit we cannot see (a normalised or engineering-unit OP).
+const PINNED_RUN: usize = 3;
+
+/// The usable stretches `[start, end)`, in order, and what was left out.
+pub(super) fn usable(r: &Record, req: &DiagnoseRequest) -> (Vec<(usize, usize)>, Excluded) {
+    let n = r.op.len();
+    let mut excluded = Excluded::default();
+    let saturated = saturated_samples(r.op, req.op_range);
+    let breaks = time_breaks(r.time, n, req.limits.gap_steps);
+    excluded.time_breaks = breaks.iter().filter(|&&b| b).count();
+    let mut ok = vec![true; n];
+    for k in 0..n {
+        let present = r.op[k].is_finite()
+            && r.pv[k].is_finite()
+            && r.sp.is_none_or(|s| s[k].is_finite())
+            && r.mv.is_none_or(|m| m[k].is_finite());
+        if r.auto.is_some_and(|a| !a[k]) {
+            excluded.manual += 1;
+            ok[k] = false;
+        } else if !present {
+            excluded.missing += 1;
+            ok[k] = false;
+        } else if saturated[k] {
+            excluded.saturated += 1;
+            ok[k] = false;
+        }
+    }
+    let mut out = Vec::new();
+    let mut start = None;
+    for k in 0..=n {
+        let usable = k < n && ok[k];
+        let broken = k < n && breaks[k];
+        match start {
+            Some(s) if !usable || broken => {
+                out.push((s, k));
+                start = usable.then_some(k);
+            }
+            None if usable => start = Some(k),
+            _ => {}
+        }
+    }
+    (out, excluded)
+}
+
+/// Samples with OP at a limit: at the ends of `op_range` when OP stays within it, or held at the
+/// record's own extreme for a while.
+fn saturated_samples(op: &[f64], [lo_range, hi_range]: [f64; 2]) -> Vec<bool> {
+    let finite = op.iter().copied().filter(|v| v.is_finite());
+    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    let within = lo >= lo_range && hi <= hi_range;
+    let mut out = vec![false; op.len()];
+    let mut k = 0;
+    while k < op.len() {
+        let v = op[k];
+        let mut run = 1;
+        while k + run < op.len() && op[k + run] == v {
+            run += 1;
+        }
+        let at_range_limit = within && (v <= lo_range || v >= hi_range);
+        let pinned = hi > lo && (v == lo || v == hi) && run >= PINNED_RUN;
+        if at_range_limit || pinned {
+            out[k..k + run].fill(true);
+        }
+        k += run;
+    }
+    out
+}
+
+/// `true` at a sample that starts after a gap (a time step longer than `gap_steps` median steps)
+/// or where time does not increase.
+fn time_breaks(time: Option<&[f64]>, n: usize, gap_steps: f64) -> Vec<bool> {
+    let Some(t) = time else {
+        return vec![false; n];
+    };
+    let mut steps: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    let ts = steps.get(steps.len() / 2).copied().unwrap_or(0.0);
+    let mut out = vec![false; t.len()];
+    for k in 1..t.len() {
+        let step = t[k] - t[k - 1];
+        out[k] = step.is_nan() || step <= 0.0 || (ts > 0.0 && step > gap_steps * ts);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record<'a>(op: &'a [f64], pv: &'a [f64]) -> Record<'a> {
+        Record {
+            op,
+            pv,
+            sp: None,
+            mv: None,
+            time: None,
+            auto: None,
+        }
+    }
+
+    #[test]
+    fn gaps_manual_mode_and_saturation_split_the_record() {
+        let n = 100;
+        let mut op: Vec<f64> = (0..n).map(|k| 40.0 + (k % 7) as f64).collect();
+        let mut pv = vec![1.0; n];
+        pv[10] = f64::NAN;
+        op[50..53].fill(100.0);
+        let mut auto = vec![true; n];
+        auto[80..85].fill(false);
+        let mut t: Vec<f64> = (0..n).map(|k| k as f64).collect();
+        for v in &mut t[90..] {
+            *v += 50.0;
+        }
+        let r = Record {
+            auto: Some(&auto),
+            time: Some(&t),
+            ..record(&op, &pv)
+        };
+        let (s, ex) = usable(&r, &DiagnoseRequest::default());
+        assert_eq!(s, vec![(0, 10), (11, 50), (53, 80), (85, 90), (90, 100)]);
+        assert_eq!(
+            ex,
+            Excluded {
+                manual: 5,
+                missing: 1,
+                saturated: 3,
+                time_breaks: 1
+            }
+        );
+    }
+
+    #[test]
+    fn a_clean_record_is_one_stretch() {
+        let op: Vec<f64> = (0..50).map(|k| 50.0 + (k as f64).sin()).collect();
+        let pv = op.clone();
+        let (s, _) = usable(&record(&op, &pv), &DiagnoseRequest::default());
+        assert_eq!(s, vec![(0, 50)]);
+    }
+}

@@ -1,0 +1,219 @@
+//! The verdict from the families: families that agree give `stiction` or `no_stiction` with a
+//! confidence; families that conflict give `undetermined`, naming the conflict. The valve family
+//! (the recorded valve position) outweighs the indirect ones. Against the loop family's evidence
+//! of a non-linearity, the shape, fit and stick-slip votes against stiction count only weakly.
+
+use super::evidence::{Family, FamilyEvidence};
+use super::result::{Verdict, Vote};
+
+/// What the families decide.
+pub(super) struct Decision {
+    pub verdict: Verdict,
+    pub confidence: Option<f64>,
+    pub reason: Option<String>,
+    pub evidence: Vec<String>,
+    pub next_step: String,
+}
+
+/// A side of a conflict wins when its total strength is at least this many times the other's and
+/// no single vote against it is stronger than `WEAK_DISSENT`.
+const DOMINANCE: f64 = 1.0;
+const WEAK_DISSENT: f64 = 0.5;
+/// A stiction verdict needs at least one vote this strong.
+const DECIDES: f64 = 0.5;
+
+/// Against the loop family's evidence of a non-linearity that sustains the cycle, a vote against
+/// stiction that reads the cycle's shape or a fit (shape, model, stick-slip) counts at most this:
+/// a fast loop's valve can stick for less than a sample, which leaves the cycle near-sinusoidal,
+/// the fits with and without a band alike and no stick-slip episode to find (detection.md, "A
+/// limit cycle that no linear loop can sustain").
+const BLIND_AGAINST_LOOP: f64 = 0.15;
+
+/// A vote's strength in the verdict: its own, unless it is one of the votes against stiction
+/// that held loop evidence for it (`loop_holds`: a stiction vote of strength 0.5 or more)
+/// outweighs. Weaker loop evidence (no setpoint recorded) only keeps them from deciding.
+fn weight(f: &FamilyEvidence, loop_holds: bool) -> f64 {
+    let blind = matches!(f.family, Family::Shape | Family::Model | Family::StickSlip);
+    if loop_holds && blind && f.vote == Vote::NoStiction {
+        f.strength.min(BLIND_AGAINST_LOOP)
+    } else {
+        f.strength
+    }
+}
+
+/// Independent evidence: the chance that every supporting family is wrong, taken as the product.
+fn combined(strengths: impl Iterator<Item = f64>) -> f64 {
+    1.0 - strengths.fold(1.0, |p, s| p * (1.0 - s.clamp(0.0, 0.99)))
+}
+
+fn names(fams: &[&FamilyEvidence]) -> String {
+    let words: Vec<&str> = fams.iter().map(|f| f.family.words()).collect();
+    match words.as_slice() {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+    }
+}
+
+/// Decide from the families' votes (`oscillating`: the loop oscillates, so a record no family
+/// could judge is not short of excitation).
+pub(super) fn decide(families: &[FamilyEvidence], oscillating: bool) -> Decision {
+    let evidence: Vec<String> = families
+        .iter()
+        .map(|f| {
+            format!(
+                "{}: {} ({})",
+                f.family.words(),
+                match f.vote {
+                    Vote::Stiction => "stiction",
+                    Vote::NoStiction => "no stiction",
+                    Vote::Undetermined => "undetermined",
+                },
+                f.note
+            )
+        })
+        .collect();
+    let of =
+        |v: Vote| -> Vec<&FamilyEvidence> { families.iter().filter(|f| f.vote == v).collect() };
+    let (pro, con) = (of(Vote::Stiction), of(Vote::NoStiction));
+    if let Some(valve) = families
+        .iter()
+        .find(|f| f.family == Family::Valve && f.vote != Vote::Undetermined)
+    {
+        let others: Vec<&FamilyEvidence> = families
+            .iter()
+            .filter(|f| f.family != Family::Valve && f.vote != Vote::Undetermined)
+            .collect();
+        let agree = others.iter().filter(|f| f.vote == valve.vote).count();
+        let share = if others.is_empty() {
+            1.0
+        } else {
+            agree as f64 / others.len() as f64
+        };
+        let verdict = if valve.vote == Vote::Stiction {
+            Verdict::Stiction
+        } else {
+            Verdict::NoStiction
+        };
+        return Decision {
+            verdict,
+            confidence: Some(0.8 + 0.2 * share),
+            reason: None,
+            next_step: next_step(verdict, families),
+            evidence,
+        };
+    }
+    let loop_pro = pro.iter().any(|f| f.family == Family::Loop);
+    let loop_holds = pro
+        .iter()
+        .any(|f| f.family == Family::Loop && f.strength >= 0.5);
+    let w = |f: &&FamilyEvidence| weight(f, loop_holds);
+    let total = |fs: &[&FamilyEvidence]| fs.iter().map(w).sum::<f64>();
+    let strongest = |fs: &[&FamilyEvidence]| fs.iter().map(w).fold(0.0, f64::max);
+    let (verdict, confidence, reason) = match (pro.is_empty(), con.is_empty()) {
+        (true, true) if oscillating => (
+            Verdict::Undetermined,
+            None,
+            Some(
+                "the loop oscillates but no family of evidence names the cause: the cycle is regular and near-sinusoidal, the fits with and without stiction alike, and the linear loop could sustain it by itself"
+                    .to_string(),
+            ),
+        ),
+        (true, true) => (
+            Verdict::InsufficientData,
+            None,
+            Some(
+                "no family of evidence could judge this record: the loop is not excited enough (OP and PV hardly move above their noise, no oscillation)"
+                    .to_string(),
+            ),
+        ),
+        (false, true) if strongest(&pro) < DECIDES => (
+            Verdict::Undetermined,
+            None,
+            Some(format!(
+                "only weak evidence points to stiction ({}), nothing against it",
+                names(&pro)
+            )),
+        ),
+        (false, true) => (
+            Verdict::Stiction,
+            Some(combined(pro.iter().map(w))),
+            None,
+        ),
+        (true, false) => (
+            Verdict::NoStiction,
+            Some(combined(con.iter().map(w))),
+            None,
+        ),
+        (false, false) => {
+            let (p, c) = (total(&pro), total(&con));
+            if p >= DOMINANCE * c && strongest(&con) <= WEAK_DISSENT && strongest(&pro) >= DECIDES {
+                (
+                    Verdict::Stiction,
+                    Some(combined(pro.iter().map(w)) * (1.0 - c / (p + c))),
+                    None,
+                )
+            } else if c >= DOMINANCE * p && strongest(&pro) <= WEAK_DISSENT && !loop_pro {
+                (
+                    Verdict::NoStiction,
+                    Some(combined(con.iter().map(w)) * (1.0 - p / (p + c))),
+                    None,
+                )
+            } else {
+                (
+                    Verdict::Undetermined,
+                    None,
+                    Some(format!(
+                        "the families disagree: {} point to stiction, {} do not",
+                        names(&pro),
+                        names(&con)
+                    )),
+                )
+            }
+        }
+    };
+    Decision {
+        verdict,
+        confidence,
+        reason,
+        next_step: next_step(verdict, families),
+        evidence,
+    }
+}
+
+/// One line: what to do next.
+fn next_step(verdict: Verdict, families: &[FamilyEvidence]) -> String {
+    let voted = |fam: Family, v: Vote| families.iter().any(|f| f.family == fam && f.vote == v);
+    let op_does_not_drive = families.iter().any(|f| {
+        f.family == Family::Model
+            && f.vote == Vote::NoStiction
+            && f.model
+                .as_ref()
+                .is_some_and(|m| m.explained < super::evidence::model::MIN_EXPLAINED)
+    });
+    match verdict {
+        Verdict::Stiction => {
+            if families
+                .iter()
+                .any(|f| f.family == Family::Valve && f.vote == Vote::Stiction)
+            {
+                "maintain the valve (packing, actuator, positioner): its recorded position shows the band".into()
+            } else {
+                "valve travel test recommended (small OP steps in manual, watching PV or the valve position) to confirm before maintenance".into()
+            }
+        }
+        Verdict::NoStiction if op_does_not_drive => {
+            "look upstream: OP does not drive this variation (an external disturbance or an interacting loop)".into()
+        }
+        Verdict::NoStiction if voted(Family::Shape, Vote::NoStiction) => {
+            "the valve is not the cause: check the tuning and disturbances at the oscillation's period".into()
+        }
+        Verdict::NoStiction => "no action on the valve".into(),
+        Verdict::Undetermined => {
+            "record the valve position (MV) or run a valve travel test to settle it".into()
+        }
+        Verdict::InsufficientData => {
+            "use a longer record in automatic with the loop excited (setpoint changes or disturbances)".into()
+        }
+    }
+}

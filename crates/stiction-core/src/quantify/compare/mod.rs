@@ -1,0 +1,409 @@
+//! Detection by fit (Srinivasan, Rengaswamy and Miller 2005, "A Hammerstein model approach for
+//! stiction diagnosis"): the closed-loop Hammerstein model with and without stiction, on the same
+//! samples and linear structures. Where `quantify` proves the optimal band, this asks a question
+//! cheap enough to ask of every loop: how much better does any band explain the PV than a valve
+//! that follows OP?
+//!
+//! Routine records carry load changes that OP does not explain: a load that drifts enters the
+//! process beside the valve, the controller moves the valve against it, and PV stays put while the
+//! valve moves. Fitted on levels, even the true valve position then explains PV worse than OP
+//! does. So both fits compare *changes over a lag* of about the process's response time,
+//! `pv[t + L] - pv[t]` against the valve's `mv[t + L] - mv[t]`: the linear part is the same, and
+//! drifts slower than the lag fall away.
+//!
+//! The stages: the lag (from a first linear fit), where the valve stood at the first sample (a
+//! Stenman valve started elsewhere stays out of step with the real one for good: candidates are
+//! judged on the first samples), the exact Stenman band (every distinct valve trajectory; staged
+//! on long records), Kano's band and slip jump around it, and all fits moved to their output-error
+//! optimum before they are compared.
+
+mod band;
+
+use super::problem::{difference, range};
+use crate::detect::measurement_noise;
+use crate::identify::{self, Data, Fit, SearchRange, Structure};
+use crate::models::{Kano, Model, Stenman};
+use band::{exact_band, valve_start};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// What the comparison needs besides OP and PV.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CompareRequest {
+    /// Sampling time, seconds.
+    pub ts: f64,
+    /// Largest delay tried, in samples.
+    pub max_delay: usize,
+    /// `Some(true)`: integrating process only; `Some(false)`: self-regulating only; `None`: both.
+    pub integrating: Option<bool>,
+}
+
+impl Default for CompareRequest {
+    fn default() -> Self {
+        Self {
+            ts: 1.0,
+            max_delay: 30,
+            integrating: None,
+        }
+    }
+}
+
+/// One model's fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelFit {
+    /// Stiction parameters in OP units: none for the linear loop, `[d]` for Stenman, `[S, J]` for
+    /// Kano.
+    pub params: Vec<f64>,
+    /// Simulation (output-error) sum of squares of the compared output.
+    pub sse: f64,
+    /// R² in simulation of the compared output.
+    pub r2: f64,
+}
+
+/// The fits with and without stiction on one record.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitComparison {
+    /// The linear structure the stiction fits use.
+    pub structure: Structure,
+    /// The lag (samples) of the changes compared: `pv[t + lag] - pv[t]`.
+    pub lag: usize,
+    /// Samples the sums run over.
+    pub samples_used: usize,
+    /// Sum of squares of the centred compared output.
+    pub sst: f64,
+    /// The variance of the measurement noise in the compared output, per sample.
+    pub noise_var: f64,
+    /// The valve position at the first sample the stiction fits start from.
+    pub valve_start: f64,
+    /// The valve follows OP.
+    pub linear: ModelFit,
+    pub stenman: ModelFit,
+    /// Kano (S, J): a band and a slip jump of their own.
+    pub slip_jump: ModelFit,
+    /// Gain (PV units per OP unit; per second for an integrating process), time constant and
+    /// dead time (seconds) of the linear part fitted with the best stiction model.
+    pub gain: Option<f64>,
+    pub time_constant: Option<f64>,
+    pub dead_time: f64,
+    /// Candidates fitted.
+    pub evaluations: u64,
+    /// The PV a valve that follows OP would give, through the linear loop's model, on the PV's
+    /// level (without the loads OP does not explain: compare its changes, not its level).
+    #[serde(skip)]
+    pub pv_linear: Vec<f64>,
+    /// The PV the best stiction model gives, on the PV's level (as `pv_linear`).
+    #[serde(skip)]
+    pub pv_stiction: Vec<f64>,
+    /// The valve position of the best stiction model.
+    #[serde(skip)]
+    pub mv_stiction: Vec<f64>,
+    /// The linear loop's fitted model (a valve that follows OP) and the best stiction model's
+    /// linear part: ARX coefficients of the compared (differenced) output, the same dynamics as
+    /// the PV's.
+    #[serde(skip)]
+    pub linear_model: Option<Fit>,
+    #[serde(skip)]
+    pub stiction_model: Option<Fit>,
+    /// The mean OP subtracted from the valve position before fitting levels.
+    pub op_offset: f64,
+}
+
+/// Bands (shares of the OP range) at which the linear structure is chosen again.
+const PILOT_BANDS: [f64; 2] = [0.02, 0.1];
+/// Structures refined towards the output-error optimum per compared fit.
+const REFINED_STRUCTURES: usize = 3;
+/// Steiglitz-McBride iterations towards each compared fit's output-error optimum.
+const OE_ITERATIONS: usize = 4;
+/// The lag is this many times the process's response time (time constant and dead time) ...
+const LAG_RESPONSES: f64 = 1.5;
+/// ... at least `MIN_LAG` samples and at most this share of the record.
+const MIN_LAG: usize = 2;
+const MAX_LAG_SHARE: usize = 10;
+/// An integrating process's changes are compared over at least this share of the record.
+const INTEGRATING_LAG_SHARE: usize = 25;
+
+/// Compare the closed-loop fits with and without stiction. `None` when no linear model can be
+/// fitted (too few samples, OP or PV constant).
+pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitComparison> {
+    let n = op.len();
+    let (lo, hi) = range(op);
+    let op_range = hi - lo;
+    if n != pv.len() || op_range.is_nan() || op_range <= 0.0 || range(pv).1 <= range(pv).0 {
+        return None;
+    }
+    let mut search = SearchRange::new(req.max_delay.min(n / 20).max(1));
+    if let Some(integrating) = req.integrating {
+        search.integrating = integrating;
+        search.self_regulating = !integrating;
+    }
+    let t0 = search.t0();
+    let offset = op.iter().sum::<f64>() / n as f64;
+    let op_centred: Vec<f64> = op.iter().map(|v| v - offset).collect();
+    // the lag: the response time of a first linear fit on levels
+    let levels = Data::new(pv, t0);
+    let first = identify::select(&levels, &op_centred, &search)?.structure;
+    let first_fit = identify::fit(&levels, &op_centred, first)?;
+    let phys = identify::physical(&first_fit, req.ts);
+    let response = phys.time_constant.unwrap_or(0.0) + phys.dead_time;
+    // (an oscillating sticky loop's linear fit on levels is poor: its response time is read off
+    // the PV's autocorrelation too, whichever is longer)
+    let mut lag = ((LAG_RESPONSES * response / req.ts).round() as usize).max(half_correlation(pv));
+    if first.integrating {
+        // a level's change grows with the lag while its noise does not: a long lag
+        lag = lag.max(n / INTEGRATING_LAG_SHARE);
+    }
+    let lag = lag.clamp(MIN_LAG, (n / MAX_LAG_SHARE).max(MIN_LAG));
+    if n < lag + t0 + 20 * (search.na.len() + search.nb_max + 1) {
+        return None;
+    }
+    // changes over the lag are bounded even for an integrating process (over the lag its level
+    // changes by the sum of its inflow): compared with self-regulating structures, whose
+    // simulation errors are those of the PV's changes, not of its noisy rate
+    search.integrating = false;
+    search.self_regulating = true;
+    let mut y = vec![0.0; n - lag];
+    difference(pv, lag, &mut y);
+    let data = Data::new(&y, t0);
+    let mut linear_mv = vec![0.0; n - lag];
+    difference(op, lag, &mut linear_mv);
+    let s0 = identify::select(&data, &linear_mv, &search)?.structure;
+    let problem = Problem {
+        op,
+        data: &data,
+        lag,
+        start: None,
+    };
+    let mut evaluations = 3;
+    // the structures: the linear loop's, and those chosen at a few bands across the OP range
+    let mut structures = vec![s0];
+    for f in PILOT_BANDS {
+        let m = Model::Stenman(Stenman::new(f * op_range).ok()?);
+        if let Some(sel) = identify::select(&data, &problem.valve(&m), &search) {
+            if !structures.contains(&sel.structure) {
+                structures.push(sel.structure);
+            }
+        }
+        evaluations += 1;
+    }
+    let (x0, walked) = valve_start(op, &y, t0, lag, &structures, op_range);
+    evaluations += walked;
+    let problem = Problem {
+        start: Some(x0),
+        ..problem
+    };
+    // the Stenman band, exactly: every distinct valve trajectory, under each structure
+    let (bands, walked) = exact_band(op, &y, &data, &structures, op_range, lag, x0);
+    evaluations += walked;
+    // the linear loop and each structure's stiction fit, over the structures and their
+    // neighbours, each moved to its output-error optimum: the comparison is fair only at both
+    // optima
+    let mut tried: Vec<Structure> = Vec::new();
+    for s in structures.iter().flat_map(|&s| neighbours(s)) {
+        if !tried.contains(&s) {
+            tried.push(s);
+        }
+    }
+    // (the few structures whose least-squares fits simulate best are refined)
+    let optimum = |mv: &[f64], among: &[Structure]| -> Option<Fit> {
+        let mut fits: Vec<Fit> = among
+            .iter()
+            .filter_map(|&s| identify::fit(&data, mv, s).filter(Fit::stable))
+            .collect();
+        fits.sort_by(|x, y| x.sse_simulation.total_cmp(&y.sse_simulation));
+        fits.truncate(REFINED_STRUCTURES);
+        fits.iter()
+            .map(|f| identify::refine_output_error(&data, mv, f, OE_ITERATIONS))
+            .min_by(|x, y| x.sse_simulation.total_cmp(&y.sse_simulation))
+            .and_then(|f| identify::polish_output_error(&data, mv, &f))
+    };
+    let linear_fit = optimum(&linear_mv, &tried);
+    evaluations += tried.len() as u64;
+    let mut stenman_fit: Option<(Model, Fit)> = None;
+    for &(d, s) in &bands {
+        let Ok(m) = Stenman::new(d).map(Model::Stenman) else {
+            continue;
+        };
+        if let Some(f) = optimum(&problem.valve(&m), &neighbours(s)) {
+            if stenman_fit
+                .as_ref()
+                .is_none_or(|b| f.sse_simulation < b.1.sse_simulation)
+            {
+                stenman_fit = Some((m, f));
+            }
+        }
+    }
+    let (best_model, fit_stenman) = stenman_fit?;
+    let structure = fit_stenman.structure;
+    let best = (best_model, fit_stenman.sse_simulation);
+    let d = best.0.values()[0];
+    // Kano's band S and slip jump J around the Stenman band (J = S is close to Stenman's valve)
+    let mut kano: Vec<Model> = Vec::new();
+    for fs in [0.5, 0.75, 1.0, 1.25, 1.5, 2.0] {
+        for fj in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            let s = (fs * d).min(op_range);
+            if let Ok(k) = Kano::new(s, fj * s) {
+                kano.push(Model::Kano(k));
+            }
+        }
+    }
+    let mut slip = problem.best_of(structure, &kano);
+    evaluations += kano.len() as u64;
+    let fit_slip = optimum(&problem.valve(&slip.0), &neighbours(structure))
+        .unwrap_or_else(|| fit_stenman.clone());
+    slip.1 = slip.1.min(fit_slip.sse_simulation);
+    if best.1 < slip.1 {
+        // Stenman's valve is a slip-jump valve too: never report a worse fit for the family
+        slip = best;
+    }
+    let (stiction, fit_s) = if slip.1 < best.1 {
+        (&slip, fit_slip)
+    } else {
+        (&best, fit_stenman)
+    };
+    // the linear loop may do as well from the stiction fit's dynamics: a comparison of fits is
+    // fair only when neither optimisation stopped short
+    let linear_fit = match (
+        linear_fit,
+        identify::polish_output_error(&data, &linear_mv, &fit_s),
+    ) {
+        (Some(a), Some(b)) => Some(if b.sse_simulation < a.sse_simulation {
+            b
+        } else {
+            a
+        }),
+        (a, b) => a.or(b),
+    };
+    let sst = fit_s.sst;
+    let phys = identify::physical(&fit_s, req.ts);
+    let mv_stiction = stiction.0.simulate_from(op, Some(x0));
+    let mv_centred: Vec<f64> = mv_stiction.iter().map(|v| v - offset).collect();
+    let pv_stiction = identify::simulate_pv(&levels, &mv_centred, &fit_s);
+    let pv_linear = linear_fit
+        .as_ref()
+        .map(|f| identify::simulate_pv(&levels, &op_centred, f))
+        .unwrap_or_default();
+    let r2 = |sse: f64| 1.0 - sse / sst;
+    let linear_sse = linear_fit
+        .as_ref()
+        .map_or(sst, |f| f.sse_simulation.min(sst));
+    // the compared output's noise: white noise differenced over the lag (twice again for an
+    // integrating structure's change)
+    let sigma = measurement_noise(pv);
+    let noise_var = 2.0 * sigma * sigma;
+    Some(FitComparison {
+        structure,
+        lag,
+        samples_used: data.used(),
+        sst,
+        noise_var,
+        valve_start: x0,
+        linear: ModelFit {
+            params: Vec::new(),
+            sse: linear_sse,
+            r2: r2(linear_sse),
+        },
+        stenman: ModelFit {
+            params: vec![d],
+            sse: best.1,
+            r2: r2(best.1),
+        },
+        slip_jump: ModelFit {
+            params: stiction_params(&slip.0),
+            sse: slip.1,
+            r2: r2(slip.1),
+        },
+        gain: phys.gain,
+        time_constant: phys.time_constant,
+        dead_time: phys.dead_time,
+        evaluations,
+        pv_linear,
+        pv_stiction,
+        mv_stiction,
+        linear_model: linear_fit,
+        stiction_model: Some(fit_s),
+        op_offset: offset,
+    })
+}
+
+/// The first lag at which the autocorrelation of the PV (its straight-line trend removed) falls
+/// below one half: about the time the loop takes to forget where PV was.
+fn half_correlation(pv: &[f64]) -> usize {
+    let n = pv.len();
+    let (tm, ym) = ((n as f64 - 1.0) / 2.0, pv.iter().sum::<f64>() / n as f64);
+    let (mut stt, mut sty) = (0.0, 0.0);
+    for (t, y) in pv.iter().enumerate() {
+        stt += (t as f64 - tm).powi(2);
+        sty += (t as f64 - tm) * (y - ym);
+    }
+    let slope = if stt > 0.0 { sty / stt } else { 0.0 };
+    let x: Vec<f64> = pv
+        .iter()
+        .enumerate()
+        .map(|(t, y)| y - ym - slope * (t as f64 - tm))
+        .collect();
+    let acf = crate::detect::autocorrelation(&x, n / MAX_LAG_SHARE);
+    acf.iter().position(|&r| r < 0.5).unwrap_or(acf.len())
+}
+
+/// A structure, then the same delay and family with the other orders: an equation-error fit of a
+/// disturbed loop can put a pole on or outside the unit circle, and its simulation runs away.
+fn neighbours(s: Structure) -> Vec<Structure> {
+    let mut out = vec![s];
+    for (na, nb) in [(1, 1), (1, 2), (2, 1), (2, 2), (0, 2), (0, 1)] {
+        let t = Structure { na, nb, ..s };
+        if !out.contains(&t) {
+            out.push(t);
+        }
+    }
+    out
+}
+
+fn stiction_params(m: &Model) -> Vec<f64> {
+    match m {
+        // Stenman's valve as a slip-jump model: S = J = d
+        Model::Stenman(s) => vec![s.d, s.d],
+        other => other.values(),
+    }
+}
+
+/// The candidates' shared data.
+#[derive(Clone, Copy)]
+struct Problem<'a> {
+    op: &'a [f64],
+    data: &'a Data<'a>,
+    lag: usize,
+    start: Option<f64>,
+}
+
+impl Problem<'_> {
+    /// A valve trajectory differenced over the lag.
+    fn valve(&self, m: &Model) -> Vec<f64> {
+        let full = m.simulate_from(self.op, self.start);
+        let mut mv = vec![0.0; self.op.len() - self.lag];
+        difference(&full, self.lag, &mut mv);
+        mv
+    }
+
+    /// The candidate of least simulation error under one structure (ties: the first).
+    fn best_of(&self, s: Structure, candidates: &[Model]) -> (Model, f64) {
+        let prepared = identify::Prepared::new(self.data, s);
+        let n = self.op.len();
+        let costs: Vec<f64> = candidates
+            .par_iter()
+            .with_min_len(4)
+            .map_init(
+                || (vec![0.0; n], vec![0.0; n - self.lag]),
+                |(full, mv), m| {
+                    m.simulate_from_into(self.op, self.start, full);
+                    difference(full, self.lag, mv);
+                    prepared
+                        .fit(mv)
+                        .filter(Fit::stable)
+                        .map_or(f64::INFINITY, |f| f.sse_simulation)
+                },
+            )
+            .collect();
+        let i = (0..costs.len()).fold(0, |b, i| if costs[i] < costs[b] { i } else { b });
+        (candidates[i], costs[i])
+    }
+}

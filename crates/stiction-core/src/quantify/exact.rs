@@ -1,0 +1,272 @@
+//! Stenman, exact: every distinct valve trajectory (cell of the partition of the d-range) is
+//! simulated once and fitted with each of the given linear structures. The range is cut into fixed
+//! chunks walked in parallel, so the work spreads over threads and the result does not depend on
+//! their number. Without `full`, only the chunks around the best points of a coarse scan are walked
+//! (faster, exact only there).
+
+use super::problem::Hammerstein;
+use super::search::Outcome;
+use crate::estimate::exact;
+use crate::identify;
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+
+/// Cells of the first samples carried into the whole-record search of a staged search.
+const TOP_CELLS: usize = 24;
+/// Chunks the whole d-range is cut into (geometric: bands are usually small).
+const CHUNKS: usize = 64;
+/// Consecutive cells' sums are updated incrementally; a full recomputation this often bounds
+/// rounding.
+const FULL_EVERY: usize = 256;
+
+/// A cell of the d-partition with its cost under each structure.
+type CellCosts = ((f64, f64), Vec<f64>);
+
+/// One outcome per structure (problem), in order. `only`: a staged search's ranges of d.
+pub(super) fn exact_stenman(
+    problems: &[Hammerstein],
+    (lo, hi): (f64, f64),
+    full: bool,
+    only: Option<&[(f64, f64)]>,
+) -> Vec<Outcome> {
+    let full = full || only.is_some();
+    let mut chunks = chunks(lo, hi, only);
+    let scan: Vec<f64> = chunks.iter().map(|c| 0.5 * (c.0 + c.1)).collect();
+    let scan_costs: Vec<Vec<f64>> = problems.iter().map(|p| p.costs_1d(&scan)).collect();
+    if !full {
+        chunks = around_best(&chunks, &scan_costs);
+    }
+    // achievable costs to start from: simulations that exceed them stop early (such a cell can
+    // never be optimal, so the optimal set is the same whatever the order of the work)
+    let start_bounds: Vec<f64> = scan_costs
+        .iter()
+        .map(|c| c.iter().copied().fold(f64::INFINITY, f64::min))
+        .collect();
+    let n = problems[0].len();
+    let per_chunk: Vec<Vec<CellCosts>> = chunks
+        .par_iter()
+        .map_init(
+            || Walk::new(n),
+            |walk, &chunk| walk.chunk(problems, chunk, (lo, hi), &start_bounds),
+        )
+        .collect();
+    let cells: Vec<CellCosts> = per_chunk.into_iter().flatten().collect();
+    let kind = match (only.is_some(), full) {
+        (true, _) => "exact_staged",
+        (false, true) => "exact",
+        (false, false) => "exact_local",
+    };
+    (0..problems.len())
+        .map(|s| outcome(&cells, s, (lo, hi), kind, scan.len()))
+        .collect()
+}
+
+/// The chunks to walk: a staged search's ranges, each cut in a few chunks for the threads, or the
+/// whole range cut geometrically.
+fn chunks(lo: f64, hi: f64, only: Option<&[(f64, f64)]>) -> Vec<(f64, f64)> {
+    match only {
+        Some(ranges) => ranges
+            .iter()
+            .flat_map(|&(a, b)| {
+                let k = 4;
+                (0..k).map(move |i| {
+                    (
+                        a + (b - a) * i as f64 / k as f64,
+                        a + (b - a) * (i + 1) as f64 / k as f64,
+                    )
+                })
+            })
+            .filter(|c| c.1 > c.0)
+            .collect(),
+        None => {
+            let first = (hi - lo) * 1e-4;
+            let mut edges: Vec<f64> = (0..CHUNKS)
+                .map(|i| lo + first * ((hi - lo) / first).powf(i as f64 / (CHUNKS - 1) as f64))
+                .collect();
+            edges[0] = lo;
+            edges.push(hi);
+            edges.dedup();
+            edges.windows(2).map(|w| (w[0], w[1])).collect()
+        }
+    }
+}
+
+/// The chunks around the three best scan points of each structure, with their neighbours.
+fn around_best(chunks: &[(f64, f64)], scan_costs: &[Vec<f64>]) -> Vec<(f64, f64)> {
+    let mut keep = Vec::new();
+    for costs in scan_costs {
+        let mut order: Vec<usize> = (0..chunks.len()).collect();
+        order.sort_by(|&i, &j| costs[i].total_cmp(&costs[j]));
+        keep.extend(
+            order
+                .iter()
+                .take(3)
+                .flat_map(|&i| [i.saturating_sub(1), i, (i + 1).min(chunks.len() - 1)]),
+        );
+    }
+    chunks
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| keep.contains(i))
+        .map(|(_, &c)| c)
+        .collect()
+}
+
+/// One thread's buffers for walking chunks of the d-partition.
+struct Walk {
+    /// The valve trajectory (the whole record)
+    full: Vec<f64>,
+    /// ... as the linear part sees it (differenced when the problems are), and the previous one.
+    mv: Vec<f64>,
+    prev: Vec<f64>,
+    changed: Vec<usize>,
+    rows: Vec<usize>,
+}
+
+impl Walk {
+    /// `n`: samples the linear part sees.
+    fn new(n: usize) -> Self {
+        Self {
+            full: Vec::new(),
+            mv: vec![0.0; n],
+            prev: vec![0.0; n],
+            changed: Vec::new(),
+            rows: Vec::new(),
+        }
+    }
+
+    /// Every cell of one chunk with its cost under each structure. Consecutive cells'
+    /// trajectories differ only on short stretches (they join again at the next slip both make),
+    /// so the walk keeps the least-squares sums of its previous cell and updates only the rows
+    /// that see a changed sample.
+    fn chunk(
+        &mut self,
+        problems: &[Hammerstein],
+        chunk: (f64, f64),
+        range: (f64, f64),
+        start_bounds: &[f64],
+    ) -> Vec<CellCosts> {
+        let Walk {
+            full,
+            mv: seen,
+            prev,
+            changed,
+            rows,
+        } = self;
+        let n = seen.len();
+        let (offset, lag) = (problems[0].offset, problems[0].lag);
+        let mut out = Vec::new();
+        let mut bounds = start_bounds.to_vec();
+        let mut sums: Vec<identify::ValveSums> = Vec::new();
+        let x0 = problems[0].start.unwrap_or(problems[0].op[0]);
+        full.resize(problems[0].op.len(), 0.0);
+        exact::stenman_walk(problems[0].op, x0, chunk, range, full, |cell, full| {
+            let mv: &mut [f64] = if lag == 0 {
+                for v in full.iter_mut() {
+                    *v -= offset;
+                }
+                full
+            } else {
+                super::problem::difference(full, lag, seen);
+                seen
+            };
+            let refresh = sums.is_empty() || out.len() % FULL_EVERY == 0;
+            changed.clear();
+            if !refresh {
+                changed_samples(mv, prev, changed);
+            }
+            if !refresh && changed.len() < n / 8 {
+                for (p, s) in problems.iter().zip(sums.iter_mut()) {
+                    p.prepared.update_sums(s, prev, mv, changed, rows);
+                }
+            } else {
+                sums = problems.iter().map(|p| p.prepared.sums(mv)).collect();
+            }
+            let costs: Vec<f64> = problems
+                .iter()
+                .zip(&sums)
+                .zip(bounds.iter_mut())
+                .map(|((p, s), bound)| {
+                    let c = p
+                        .prepared
+                        .fit_from_sums(s, mv, *bound)
+                        .map_or(f64::INFINITY, |f| f.sse_simulation);
+                    *bound = bound.min(c);
+                    c
+                })
+                .collect();
+            prev.copy_from_slice(mv);
+            out.push((cell, costs));
+        });
+        out
+    }
+}
+
+/// The samples where `mv` differs from `prev`, bit for bit, compared in blocks (most blocks are
+/// unchanged).
+fn changed_samples(mv: &[f64], prev: &[f64], changed: &mut Vec<usize>) {
+    for (blk, (m, p)) in mv.chunks(16).zip(prev.chunks(16)).enumerate() {
+        let differs = m
+            .iter()
+            .zip(p)
+            .fold(0u64, |acc, (x, y)| acc | (x.to_bits() ^ y.to_bits()));
+        if differs != 0 {
+            let base = blk * 16;
+            changed.extend(
+                (0..m.len())
+                    .filter(|&i| m[i].to_bits() != p[i].to_bits())
+                    .map(|i| base + i),
+            );
+        }
+    }
+}
+
+/// The optimal set of structure `s` over the walked cells.
+fn outcome(
+    cells: &[CellCosts],
+    s: usize,
+    (lo, hi): (f64, f64),
+    kind: &'static str,
+    scanned: usize,
+) -> Outcome {
+    let best = cells.iter().map(|c| c.1[s]).fold(f64::INFINITY, f64::min);
+    // sums updated step by step round differently from fresh ones: a hair of tolerance
+    // keeps the pieces of one trajectory together
+    let tolerance = 1e-9 * best.abs();
+    let mut optimal: Vec<(f64, f64)> = Vec::new();
+    for (cell, costs) in cells {
+        if costs[s] <= best + tolerance {
+            match optimal.last_mut() {
+                // pieces of one cell split at a chunk edge join again
+                Some(last) if last.1 >= cell.0 => last.1 = last.1.max(cell.1),
+                _ => optimal.push(*cell),
+            }
+        }
+    }
+    // the widest optimal piece's midpoint is the point estimate; the interval their hull
+    let (a, b) = optimal
+        .iter()
+        .copied()
+        .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+        .unwrap_or((lo, hi));
+    let hull = [
+        optimal.first().map_or(lo, |c| c.0),
+        optimal.last().map_or(hi, |c| c.1),
+    ];
+    let mut ranked: Vec<&CellCosts> = cells.iter().collect();
+    ranked.sort_by(|x, y| x.1[s].total_cmp(&y.1[s]).then(x.0 .0.total_cmp(&y.0 .0)));
+    Outcome {
+        best: vec![0.5 * (a + b)],
+        interval: BTreeMap::from([("d".to_string(), hull)]),
+        interval_kind: kind,
+        evaluations: (cells.len() + scanned) as u64,
+        cells: Some(cells.len()),
+        // the best cells, and the lowest (a valve without stiction is always a candidate)
+        top_cells: ranked
+            .iter()
+            .take(TOP_CELLS)
+            .map(|c| c.0)
+            .chain(cells.first().map(|c| c.0))
+            .collect(),
+    }
+}

@@ -1,0 +1,135 @@
+//! The closed-loop objective (argmin's "problem"): for stiction parameters θ, simulate the valve
+//! from OP, fit the linear part by least squares and score the fit by its simulation error.
+
+use crate::estimate::solver::CostFunction;
+use crate::identify::{self, Data, Fit, Structure};
+use crate::models::ModelKind;
+use rayon::prelude::*;
+
+pub(super) fn range(v: &[f64]) -> (f64, f64) {
+    v.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        })
+}
+
+/// `out[t] = x[t + lag] - x[t]`, for `t` in `0..x.len() - lag`.
+pub(super) fn difference(x: &[f64], lag: usize, out: &mut [f64]) {
+    for (t, o) in out.iter_mut().enumerate() {
+        *o = x[t + lag] - x[t];
+    }
+}
+
+/// The closed-loop objective: simulation error of the least-squares linear fit for the valve
+/// trajectory of each candidate.
+pub(super) struct Hammerstein<'a> {
+    pub(super) kind: ModelKind,
+    pub(super) op: &'a [f64],
+    pub(super) prepared: identify::Prepared<'a>,
+    /// Subtracted from the valve position (the mean OP) to keep the normal equations well scaled.
+    pub(super) offset: f64,
+    /// The valve position at the first sample (`None`: the first OP).
+    pub(super) start: Option<f64>,
+    /// Compare changes over this many samples instead of levels (0: levels): the data hold
+    /// `pv[t + lag] - pv[t]` and the valve position is differenced the same way, which keeps the
+    /// linear part and removes slow load drifts that OP alone cannot explain.
+    pub(super) lag: usize,
+}
+
+impl<'a> Hammerstein<'a> {
+    pub(super) fn new(
+        kind: ModelKind,
+        op: &'a [f64],
+        data: &'a Data<'a>,
+        structure: Structure,
+        start: Option<f64>,
+    ) -> Self {
+        Self {
+            kind,
+            op,
+            prepared: identify::Prepared::new(data, structure),
+            offset: op.iter().sum::<f64>() / op.len() as f64,
+            start,
+            lag: 0,
+        }
+    }
+
+    /// The same problem on data differenced over `lag` samples (see [`Hammerstein::lag`]).
+    pub(super) fn with_lag(mut self, lag: usize) -> Self {
+        self.lag = lag;
+        self
+    }
+
+    /// Samples of the valve trajectory the linear part sees.
+    pub(super) fn len(&self) -> usize {
+        self.op.len() - self.lag
+    }
+
+    /// The valve trajectory of `theta` as the linear part sees it, into `mv` (`self.len()` long).
+    pub(super) fn valve_into(&self, theta: &[f64], mv: &mut [f64]) {
+        let model = self.kind.build(theta).expect("candidates are repaired");
+        if self.lag == 0 {
+            model.simulate_from_into(self.op, self.start, mv);
+            for v in mv.iter_mut() {
+                *v -= self.offset;
+            }
+        } else {
+            let full = model.simulate_from(self.op, self.start);
+            difference(&full, self.lag, mv);
+        }
+    }
+
+    pub(super) fn valve(&self, theta: &[f64]) -> Vec<f64> {
+        let mut mv = vec![0.0; self.len()];
+        self.valve_into(theta, &mut mv);
+        mv
+    }
+
+    pub(super) fn fit(&self, theta: &[f64]) -> Option<Fit> {
+        self.prepared.fit(&self.valve(theta))
+    }
+
+    /// The cost of one candidate, with a caller's buffer for the valve position.
+    pub(super) fn cost_with(&self, theta: &[f64], mv: &mut [f64]) -> f64 {
+        self.valve_into(theta, mv);
+        self.prepared
+            .fit(mv)
+            .map_or(f64::INFINITY, |f| f.sse_simulation)
+    }
+
+    pub(super) fn cost(&self, theta: &[f64]) -> f64 {
+        self.cost_with(theta, &mut vec![0.0; self.len()])
+    }
+
+    /// Costs of many one-parameter candidates, in parallel, one buffer per thread.
+    pub(super) fn costs_1d(&self, values: &[f64]) -> Vec<f64> {
+        let n = self.len();
+        let mut out = vec![0.0; values.len()];
+        out.par_iter_mut()
+            .zip(values.par_iter())
+            .with_min_len(8)
+            .for_each_init(
+                || vec![0.0; n],
+                |buf, (c, &v)| *c = self.cost_with(&[v], buf),
+            );
+        out
+    }
+}
+
+impl CostFunction for Hammerstein<'_> {
+    fn dim(&self) -> usize {
+        self.kind.dim()
+    }
+    fn eval_batch(&self, candidates: &[f64], costs: &mut [f64]) {
+        let dim = self.dim();
+        let n = self.len();
+        costs
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(4)
+            .for_each_init(
+                || vec![0.0; n],
+                |buf, (i, c)| *c = self.cost_with(&candidates[i * dim..(i + 1) * dim], buf),
+            );
+    }
+}

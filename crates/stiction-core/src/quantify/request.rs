@@ -1,0 +1,66 @@
+//! What `quantify` is asked to do.
+
+use crate::estimate::{AcoSettings, AcorSettings, GridSettings, Method};
+use crate::models::ModelKind;
+use serde::{Deserialize, Serialize};
+
+/// A closed-loop quantification request: the stiction model, the search method and its
+/// settings, and the linear model search.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct QuantifyRequest {
+    pub model: ModelKind,
+    pub method: Method,
+    /// Sampling time in seconds (for the time constant and dead time).
+    pub ts: f64,
+    /// Search range per stiction parameter; `None`: 0 up to the OP's peak-to-peak range.
+    pub bounds: Option<Vec<(f64, f64)>>,
+    pub seed: u64,
+    pub aco: AcoSettings,
+    pub acor: AcorSettings,
+    pub grid: GridSettings,
+    /// Largest delay tried, in samples.
+    pub max_delay: usize,
+    /// `Some(true)`: integrating process only; `Some(false)`: self-regulating only; `None`: both.
+    pub integrating: Option<bool>,
+    /// Stenman exact: fit every cell of the whole d-range, not only those around the best scan points.
+    pub full_partition: bool,
+    /// Stenman exact on long records: search the whole d-range on the first samples, then only
+    /// the best cells of that search on the whole record (every whole-record cell lies inside one
+    /// cell of the first samples', so this is exact over the cells kept). `false`: every cell of
+    /// the whole record.
+    pub staged: bool,
+    /// The valve position at the first sample (Stenman and He); `None`: where OP starts, as if
+    /// the valve had just moved there (unless `estimate_start` chooses one).
+    #[serde(default)]
+    pub valve_start: Option<f64>,
+    /// Stenman exact: choose the valve position at the first sample (a record rarely starts just
+    /// as the valve moved) among candidates across the OP's span, by the fit on the first samples.
+    /// Off by default: it costs about four more searches of the first samples.
+    #[serde(default)]
+    pub estimate_start: bool,
+}
+
+impl QuantifyRequest {
+    pub fn new(model: ModelKind, method: Method) -> Self {
+        let grid = GridSettings { points: 40 };
+        Self {
+            model,
+            method,
+            ts: 1.0,
+            bounds: None,
+            seed: 1,
+            aco: AcoSettings::default(),
+            acor: AcorSettings {
+                iterations: 60,
+                ..AcorSettings::default()
+            },
+            grid,
+            max_delay: 30,
+            integrating: None,
+            full_partition: true,
+            staged: true,
+            valve_start: None,
+            estimate_start: false,
+        }
+    }
+}
