@@ -1,3 +1,5 @@
+use crate::loop_file::Reading;
+use crate::words::count;
 use crate::{cmd_simulate::write_atomic, data, spec};
 use anyhow::{bail, Result};
 use std::path::PathBuf;
@@ -8,9 +10,13 @@ use stiction_core::models::ModelKind;
 #[command(after_help = "Examples:
   stiction estimate open.csv --model stenman --method exact
   stiction estimate open.csv --op op --mv mv --model stenman --method aco --seed 3 --json
-  stiction estimate kano.csv --model kano --method aco-r --seed 1 --trace trace.csv")]
+  stiction estimate kano.csv --model kano --method aco-r --seed 1 --trace trace.csv
+  stiction estimate valve.xlsx --sheet 'Step test' --op OUT --mv POS
+
+Missing values (blank, NaN, #N/A, historian states such as Bad Input) are gaps: the longest
+stretch without one is used, and a note says which.")]
 pub struct Args {
-    /// CSV file with a header line (comma, semicolon or tab separated)
+    /// Data file: CSV with a header line, .csv.gz, a workbook, Parquet, or - for standard input
     file: PathBuf,
     /// Column of the controller output (the valve's command)
     #[arg(long, default_value = "op")]
@@ -21,6 +27,8 @@ pub struct Args {
     /// Column of time [default: the first of t, time, timestamp, if any]
     #[arg(long)]
     time: Option<String>,
+    #[command(flatten)]
+    reading: Reading,
     #[command(flatten)]
     fit: spec::FitArgs,
     /// Write the best parameters and fit error per iteration to this CSV (aco, aco-r)
@@ -103,22 +111,36 @@ pub fn run(a: Args) -> Result<()> {
     // settings and bounds are checked before the file is read, so a typo fails fast
     req.resolved_bounds().map_err(|e| anyhow::anyhow!("{e}"))?;
 
-    let (op, mv) = data::read_pair(
-        &a.file,
+    let table = a.reading.open(&a.file)?;
+    let spec = a.reading.time_spec()?;
+    let pair = data::read_pair(
+        &table,
         (&a.op, "--op", "controller output op"),
         (&a.mv, "--mv", "valve position mv"),
-        a.time.as_deref(),
+        a.time.as_deref().map(|t| (t, &spec)),
         estimate::MIN_SAMPLES,
     )?;
-    let est = estimate::estimate(&op, &mv, &req)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", a.file.display()))?;
+    let name = table.path.display().to_string();
+    let est =
+        estimate::estimate(&pair.a, &pair.b, &req).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
     if let Some(path) = &a.trace {
         write_trace(path, kind, &est)?;
     }
+    let said = bad_fit(&est)
+        .map(|w| ("warning", w))
+        .into_iter()
+        .chain(pair.note.map(|n| ("note", n)));
     if a.fit.json {
         println!("{}", serde_json::to_string_pretty(&est)?);
+        // beside JSON, on standard error
+        for (kind, text) in said {
+            eprintln!("{kind}: {name}: {text}");
+        }
     } else {
-        print_human(&a.file.display().to_string(), &est);
+        print_human(&name, &est);
+        for (kind, text) in said {
+            println!("  {kind}: {text}");
+        }
     }
     Ok(())
 }
@@ -160,11 +182,25 @@ fn write_trace(path: &std::path::Path, kind: ModelKind, est: &Estimate) -> Resul
     write_atomic(path, text.as_bytes())
 }
 
+/// A fit worse than MV's mean (R² < 0) means the model explains nothing of MV: the columns
+/// are likelier wrong than the valve.
+fn bad_fit(e: &Estimate) -> Option<String> {
+    (e.r2 < 0.0).then(|| {
+        format!(
+            "the fit is worse than MV's mean (R² {:.3}): is MV really the valve position, and OP its command? \
+             Check --op and --mv, and that the two columns are the same valve's",
+            e.r2
+        )
+    })
+}
+
 fn print_human(file: &str, e: &Estimate) {
     let seed = e.seed.map(|s| format!(", seed {s}")).unwrap_or_default();
     println!(
-        "{file}: {} model, method {}{seed}, {} samples",
-        e.model, e.method, e.samples
+        "{file}: {} model, method {}{seed}, {}",
+        e.model,
+        e.method,
+        count(e.samples, "sample", "samples")
     );
     for spec in e.model.params() {
         let v = e.params[spec.name];
@@ -202,13 +238,12 @@ fn print_human(file: &str, e: &Estimate) {
         e.sse, e.rmse, e.r2
     );
     println!(
-        "  {} evaluations, {} {}, {:.2} ms",
-        e.evaluations,
-        e.iterations,
+        "  {}, {}, {:.2} ms",
+        count(e.evaluations, "evaluation", "evaluations"),
         if e.method == Method::Exact {
-            "cells"
+            count(e.iterations, "cell", "cells")
         } else {
-            "iterations"
+            count(e.iterations, "iteration", "iterations")
         },
         e.seconds * 1e3
     );

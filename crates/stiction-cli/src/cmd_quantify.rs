@@ -1,6 +1,8 @@
+use crate::loop_file::{read_loop, Reading, Signals};
 use crate::plot::{self, Chart, Kind, Series};
+use crate::words::{count, seconds};
 use crate::{data, spec};
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use std::path::{Path, PathBuf};
 use stiction_core::quantify::{quantify, Quantification, QuantifyRequest};
 
@@ -8,9 +10,13 @@ use stiction_core::quantify::{quantify, Quantification, QuantifyRequest};
 #[command(after_help = "Examples:
   stiction quantify loop.csv --op op --pv pv
   stiction quantify loop.csv --model kano --method aco-r --seed 2 --json
-  stiction quantify CHEM1.csv --op OP --pv PV --ts 1 --plot out/chem1")]
+  stiction quantify CHEM1.csv --op OP --pv PV --ts 1 --plot out/chem1
+  stiction quantify export.parquet --op FIC101.OP --pv FIC101.PV --tz America/Chicago
+
+Missing values (blank, NaN, #N/A, historian states such as Bad Input) are gaps: the longest
+stretch without one is used, and a note says which.")]
 pub struct Args {
-    /// CSV file with a header line (comma, semicolon or tab separated)
+    /// Data file: CSV with a header line, .csv.gz, a workbook, Parquet, or - for standard input
     file: PathBuf,
     /// Column of the controller output
     #[arg(long, default_value = "op")]
@@ -18,12 +24,14 @@ pub struct Args {
     /// Column of the process variable
     #[arg(long, default_value = "pv")]
     pv: String,
-    /// Column of time in seconds [default: the first of t, time, timestamp, if any]
+    /// Column of time (seconds, or dates such as 2024-03-01 12:00:05) [default: the first of t, time, timestamp, if any]
     #[arg(long)]
     time: Option<String>,
     /// Sampling time in seconds [default: from the time column, else 1]
     #[arg(long)]
     ts: Option<f64>,
+    #[command(flatten)]
+    reading: Reading,
     #[command(flatten)]
     fit: spec::FitArgs,
     /// Write the PV-OP phase plot with the fitted model and the trends (PNG and SVG) to this folder
@@ -42,7 +50,7 @@ pub struct Args {
     #[arg(long)]
     self_regulating: bool,
     /// exact: fit only the trajectories near the best points of a coarse scan (faster; exact there only)
-    #[arg(long)]
+    #[arg(long, conflicts_with = "full")]
     quick: bool,
     /// exact: fit every trajectory of the whole record (slower), not only the best cells of a
     /// search on the first samples (the default from 1,500 samples on)
@@ -66,29 +74,32 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<()> {
     let (kind, method) = a.fit.resolve()?;
-    if let Some(ts) = a.ts {
-        if !(ts > 0.0 && ts.is_finite()) {
-            bail!("--ts {ts}: the sampling time must be a positive number of seconds");
-        }
-    }
-    let table = data::Table::read(&a.file)?;
-    let op_col = table.require(&a.op, "--op", "controller output op")?;
-    let pv_col = table.require(&a.pv, "--pv", "process variable pv")?;
-    let time_col = data::time_column(&table, a.time.as_deref())?;
-    let op = table.numbers(op_col)?;
-    let pv = table.numbers(pv_col)?;
-    let time = time_col.map(|c| table.times(c)).transpose()?;
-    let ts = match (a.ts, &time) {
-        (Some(ts), _) => ts,
-        (None, Some(t)) => data::sampling_time(t).with_context(|| {
-            format!(
-                "{}: the time column '{}' does not increase; give the sampling time with --ts SECONDS",
-                a.file.display(),
-                table.headers[time_col.unwrap_or(0)]
-            )
-        })?,
-        (None, None) => 1.0,
+    let table = a.reading.open(&a.file)?;
+    let name = table.path.display().to_string();
+    let signals = Signals {
+        mv: None,
+        op: &a.op,
+        pv: &a.pv,
+        sp: None,
+        mode: None,
+        time: a.time.as_deref(),
+        ts: a.ts,
     };
+    let lf = read_loop(&table, &signals, &a.reading.time_spec()?)?;
+    let ts = lf.ts;
+    // a fit needs a record without gaps: the longest stretch without one
+    let stretch = data::fit_stretch(
+        &table,
+        &[(a.op.as_str(), &lf.op), (a.pv.as_str(), &lf.pv)],
+        2,
+        &|k| lf.row_of(k),
+    )?;
+    let op = lf.op[stretch.start..stretch.end].to_vec();
+    let pv = lf.pv[stretch.start..stretch.end].to_vec();
+    let time = lf
+        .time
+        .as_ref()
+        .map(|t| t[stretch.start..stretch.end].to_vec());
 
     let mut req = QuantifyRequest::new(kind, method);
     req.ts = ts;
@@ -126,7 +137,8 @@ pub fn run(a: Args) -> Result<()> {
         )?;
         req.bounds = Some(b);
     }
-    let q = quantify(&op, &pv, &req).map_err(|e| anyhow::anyhow!("{}: {e}", a.file.display()))?;
+    let q = quantify(&op, &pv, &req).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    let notes: Vec<&String> = stretch.note.iter().chain(&lf.notes).collect();
 
     if let Some(dir) = &a.plot {
         if q.status == "ok" {
@@ -140,16 +152,30 @@ pub fn run(a: Args) -> Result<()> {
     }
     if a.fit.json {
         println!("{}", serde_json::to_string_pretty(&q)?);
+        for n in notes {
+            eprintln!("note: {name}: {n}");
+        }
         return Ok(());
     }
     if q.status != "ok" {
+        let which = if stretch.note.is_some() {
+            format!(
+                " (in the longest stretch without gaps, {} to {})",
+                table.at(lf.row_of(stretch.start)),
+                table.line(lf.row_of(stretch.end - 1))
+            )
+        } else {
+            String::new()
+        };
         bail!(
-            "{}: insufficient data: {}",
-            a.file.display(),
+            "{name}: insufficient data{which}: {}",
             q.reason.as_deref().unwrap_or("the loop cannot be judged")
         );
     }
-    print_human(&a.file.display().to_string(), &q, a.plot.as_deref());
+    print_human(&name, &q, a.plot.as_deref());
+    for n in notes {
+        println!("  note: {n}");
+    }
     Ok(())
 }
 
@@ -226,16 +252,25 @@ fn print_human(file: &str, q: &Quantification, plot_dir: Option<&Path>) {
             f.r2_simulation,
             f.r2_one_step
         );
+        // how much the valve model adds: the same linear process with a valve that follows OP
+        println!(
+            "  R² in simulation with stiction {:.4}, without stiction {}",
+            f.r2_simulation,
+            f.r2_simulation_without_stiction.map_or(
+                "- (the linear fit without stiction is unstable)".into(),
+                |r| format!("{r:.4}")
+            )
+        );
     }
     let cells = q
         .cells
-        .map(|c| format!(", {c} valve trajectories"))
+        .map(|c| format!(", {}", count(c, "valve trajectory", "valve trajectories")))
         .unwrap_or_default();
     println!(
-        "  {} samples at {} s, {} evaluations{cells}, {:.1} ms",
-        q.samples,
-        q.ts,
-        q.evaluations,
+        "  {} at {} s, {}{cells}, {:.1} ms",
+        count(q.samples, "sample", "samples"),
+        seconds(q.ts),
+        count(q.evaluations, "evaluation", "evaluations"),
         q.seconds * 1e3
     );
     for w in &q.warnings {

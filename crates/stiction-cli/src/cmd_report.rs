@@ -3,12 +3,12 @@
 //! and on paper. Every text taken from the data (file and column names) is escaped.
 
 use crate::cmd_diagnose::{Columns, LoopFile};
+use crate::cmd_simulate;
 use crate::plot::{self, Chart, Kind, Series};
-use crate::{cmd_simulate, data};
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use stiction_core::diagnose::{diagnose, Diagnosis, Verdict, Vote, WindowVerdict};
+use stiction_core::diagnose::{diagnose, BandSource, Diagnosis, Verdict, Vote, WindowVerdict};
 use stiction_core::quantify::Quantification;
 
 #[derive(clap::Args)]
@@ -17,7 +17,7 @@ use stiction_core::quantify::Quantification;
   stiction report export.csv --op FIC101.OP --pv FIC101.PV --mode FIC101.MODE -o fic101.html
   stiction report level.csv --op OP --pv PV --integrating --window 2000 -o level.html")]
 pub struct Args {
-    /// CSV file with a header line (comma, semicolon or tab separated)
+    /// Data file: CSV with a header line, .csv.gz, a workbook, Parquet, or - for standard input
     pub file: PathBuf,
     #[command(flatten)]
     pub columns: Columns,
@@ -25,30 +25,36 @@ pub struct Args {
     #[arg(long)]
     pub window: Option<usize>,
     /// Skip the closed-loop estimate of the band (faster)
-    #[arg(long)]
+    #[arg(long, conflicts_with = "estimate_start")]
     pub no_quantify: bool,
     /// The HTML file to write (one self-contained page)
     #[arg(short = 'o', long = "output", value_name = "FILE.html")]
     pub output: PathBuf,
+    /// Exit with code 4 when the verdict is stiction (after writing the report), for scripts
+    #[arg(long, value_enum, value_name = "VERDICT")]
+    pub fail_on: Option<crate::cmd_diagnose::FailOn>,
 }
 
 pub fn run(a: Args) -> Result<()> {
-    let table = data::Table::read(&a.file)?;
+    let table = a.columns.open(&a.file)?;
     let lf = a.columns.read(&table)?;
     let mut req = a.columns.request(lf.ts);
     req.window = a.window;
     req.quantify = !a.no_quantify;
+    let id = table.path.display().to_string();
     let d =
-        diagnose(&lf.record(), &req).map_err(|e| anyhow::anyhow!("{}: {e}", a.file.display()))?;
-    let id = a.file.display().to_string();
+        diagnose(&lf.record(), &req).map_err(|e| crate::cmd_diagnose::core_error(&id, &lf, e))?;
     write_report_with(&a.output, &id, &lf, &d, Some(&a.columns))?;
     println!(
-        "{id}: {} (confidence {:.2}); report written to {}",
+        "{id}: {}{}; report written to {}",
         verdict_words(d.verdict),
-        d.confidence,
+        d.confidence
+            .map(|c| format!(" (confidence {c:.2})"))
+            .unwrap_or_default(),
         a.output.display()
     );
-    Ok(())
+    crate::cmd_diagnose::print_notes(&id, &lf, false);
+    crate::cmd_diagnose::FailOn::check(a.fail_on, d.verdict)
 }
 
 /// Write the report of one loop to `path` (atomically: a temporary file, then a rename).
@@ -402,16 +408,22 @@ fn header(h: &mut String, loop_id: &str, lf: &LoopFile, d: &Diagnosis, columns: 
 
 fn verdict_box(h: &mut String, d: &Diagnosis) {
     let code = d.verdict.as_str();
-    let pct = (d.confidence.clamp(0.0, 1.0) * 100.0).round();
     let _ = writeln!(
         h,
         "<section class=\"verdict v-{code}\" id=\"verdict\" aria-label=\"verdict\">\n\
-         <div class=\"verdict-head\"><span class=\"verdict-word\">{}</span>\
-         <span class=\"confidence\">confidence {:.2}</span></div>\n\
-         <div class=\"bar\" aria-hidden=\"true\"><span style=\"width:{pct}%\"></span></div>",
+         <div class=\"verdict-head\"><span class=\"verdict-word\">{}</span>{}</div>",
         capital(verdict_words(d.verdict)),
         d.confidence
+            .map(|c| format!("<span class=\"confidence\">confidence {c:.2}</span>"))
+            .unwrap_or_default()
     );
+    if let Some(c) = d.confidence {
+        let pct = (c.clamp(0.0, 1.0) * 100.0).round();
+        let _ = writeln!(
+            h,
+            "<div class=\"bar\" aria-hidden=\"true\"><span style=\"width:{pct}%\"></span></div>"
+        );
+    }
     if let Some(r) = &d.reason {
         let _ = writeln!(
             h,
@@ -428,20 +440,23 @@ fn verdict_box(h: &mut String, d: &Diagnosis) {
         }
         h.push_str("</ul>\n");
     }
-    if let Some(v) = d.apparent_stiction.as_ref().and_then(|a| a.closed_loop) {
-        let set = d
-            .apparent_stiction
-            .as_ref()
-            .and_then(|a| a.closed_loop_interval)
-            .map(|[lo, hi]| format!(" (optimal set {} to {})", num(lo), num(hi)))
+    if let Some(b) = &d.band {
+        let set = b
+            .interval_percent_of_span
+            .map(|[lo, hi]| format!(" (optimal set {} to {} %)", num(lo), num(hi)))
             .unwrap_or_default();
         let _ = writeln!(
             h,
-            "<p class=\"keyfig\"><strong>Apparent stiction: {} OP units</strong>{set}, \
-             the closed-loop estimate of the Stenman band d.</p>",
-            num(v)
+            "<p class=\"keyfig\"><strong>Stiction band: {} % of valve span</strong>{set}, {}.</p>",
+            num(b.band_percent_of_span),
+            band_source(b.source)
         );
     }
+    let _ = writeln!(
+        h,
+        "<p><strong>Next step:</strong> {}</p>",
+        esc(&d.next_step)
+    );
     h.push_str("</section>\n");
 }
 
@@ -619,18 +634,53 @@ fn phase(h: &mut String, lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification
     Ok(())
 }
 
+fn band_source(s: BandSource) -> &'static str {
+    match s {
+        BandSource::Valve => "from the recorded valve position",
+        BandSource::ClosedLoop => "the closed-loop estimate (Stenman, exact)",
+        BandSource::FitScan => "the closed-loop fit's scan of the Stenman band",
+        BandSource::StickSlip => "the median OP travel per stick",
+        BandSource::DescribingFunction => "the describing function of the loop's limit cycle",
+    }
+}
+
+fn families(h: &mut String, d: &Diagnosis) {
+    h.push_str(
+        "<h3>Families of evidence</h3>\n<p class=\"note\">Independent ways of asking whether the \
+         valve sticks; families that agree decide, families that conflict leave the verdict \
+         undetermined.</p>\n<div class=\"scroll\"><table class=\"wide\">\n<thead><tr><th>Family</th>\
+         <th>Value</th><th>Vote</th><th>Statistic</th><th>Threshold</th><th>Why</th></tr></thead>\n<tbody>\n",
+    );
+    for f in &d.families {
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td class=\"num\">{}</td><td>{}</td><td class=\"text\">{}</td>\
+             <td class=\"text\">{}</td><td class=\"text\">{}</td></tr>",
+            esc(f.family.words()),
+            opt(f.value),
+            vote_chip(f.vote),
+            esc(&f.statistic),
+            esc(&f.threshold),
+            esc(&f.note)
+        );
+    }
+    h.push_str("</tbody></table></div>\n");
+}
+
 fn indices(h: &mut String, d: &Diagnosis) {
-    h.push_str("<section id=\"indices\">\n<h2>Stiction indices</h2>\n");
+    h.push_str("<section id=\"indices\">\n<h2>Evidence</h2>\n");
+    families(h, d);
+    h.push_str("<h3>Stiction indices (shape of the oscillation)</h3>\n");
     if d.indices.is_empty() {
         let why = match d.verdict {
             Verdict::InsufficientData => "the record cannot carry a verdict (see the reason above)",
-            _ => "the loop does not oscillate regularly, so there is nothing for them to explain",
+            _ => "the loop does not oscillate regularly with a constant setpoint, so there is no shape for them to read",
         };
         let _ = writeln!(h, "<p>No index was computed: {why}.</p>");
     } else {
         h.push_str(
             "<p class=\"note\">Each index votes stiction, no stiction or undetermined against its \
-             published threshold; the verdict is the weighted vote.</p>\n\
+             published threshold; the shape family's vote is their weighted vote.</p>\n\
              <div class=\"scroll\"><table class=\"wide\">\n<thead><tr><th>Index</th><th>Value</th>\
              <th>Vote</th><th>Threshold</th><th>Weight</th><th>Reference</th><th>Note</th></tr></thead>\n<tbody>\n",
         );
@@ -714,18 +764,25 @@ fn oscillation(h: &mut String, d: &Diagnosis) {
 
 fn estimates(h: &mut String, d: &Diagnosis, q: Option<&Quantification>) {
     h.push_str("<section id=\"estimates\">\n<h2>Estimates</h2>\n<h3>Apparent stiction</h3>\n");
-    let a = d.apparent_stiction.as_ref();
-    let closed = match (a.and_then(|a| a.closed_loop), q) {
-        (Some(v), q) => {
-            let set = a
-                .and_then(|a| a.closed_loop_interval)
-                .map(|[lo, hi]| format!("; optimal set {} to {}", num(lo), num(hi)))
+    let closed = match (&d.band, q) {
+        (Some(b), _) => {
+            let set = b
+                .interval_percent_of_span
+                .map(|[lo, hi]| format!("; optimal set {} to {} %", num(lo), num(hi)))
                 .unwrap_or_default();
-            let pct = q
-                .and_then(|q| q.apparent_stiction_pct_of_op_range)
-                .map(|p| format!(" ({} % of the OP range)", num(p)))
-                .unwrap_or_default();
-            format!("<strong>{} OP units</strong>{pct}{set}", num(v))
+            let failed = d.warnings.iter().any(|w| w.contains("estimate failed"));
+            let skipped = if b.source != BandSource::Valve && d.quantification.is_none() && !failed
+            {
+                " (the exact closed-loop estimate was not run: <code>--no-quantify</code>)"
+            } else {
+                ""
+            };
+            format!(
+                "<strong>{} % of valve span</strong> ({} OP units), {}{set}{skipped}",
+                num(b.band_percent_of_span),
+                num(b.op_units),
+                band_source(b.source)
+            )
         }
         (None, _) => match d.quantification.as_ref() {
             Some(q) if q.status != "ok" => format!(
@@ -733,8 +790,7 @@ fn estimates(h: &mut String, d: &Diagnosis, q: Option<&Quantification>) {
                 esc(q.reason.as_deref().unwrap_or("insufficient data"))
             ),
             _ if d.verdict != Verdict::Stiction => {
-                "not estimated: the closed-loop estimate runs only when the verdict is stiction"
-                    .into()
+                "not estimated: the band is sized only when the verdict is stiction".into()
             }
             _ if d.warnings.iter().any(|w| w.contains("estimate failed")) => {
                 "not estimated: it failed (see the notes)".into()
@@ -742,23 +798,26 @@ fn estimates(h: &mut String, d: &Diagnosis, q: Option<&Quantification>) {
             _ => "not estimated (<code>--no-quantify</code>)".into(),
         },
     };
-    let ellipse = a
-        .and_then(|a| a.ellipse)
-        .map_or("not computed".into(), |v| format!("{} OP units", num(v)));
+    let ellipse = d
+        .band
+        .as_ref()
+        .and_then(|b| b.ellipse_percent_of_span)
+        .map_or("not computed".into(), |v| format!("{} % of span", num(v)));
     let mut rows = vec![
-        ("Closed-loop estimate (Stenman d)", closed),
+        ("Stiction band", closed),
         ("Ellipse fit of the PV-OP plot (Choudhury et al.)", ellipse),
     ];
-    if let Some(c) = &d.closed_loop_check {
+    if let Some(m) = d.families.iter().find_map(|f| f.model.as_ref()) {
         rows.push((
-            "Closed-loop check: does OP drive the oscillation?",
+            "Closed-loop fit with and without stiction",
             format!(
-                "OP explains {} % of the PV's variation above its noise ({} without stiction); at least {} % expected: <strong>{}</strong>",
-                num(100.0 * c.explained.max(0.0)),
-                c.explained_without_stiction
-                    .map_or("–".into(), |w| format!("{} %", num(100.0 * w.max(0.0)))),
-                num(100.0 * c.limit),
-                if c.passed { "passed" } else { "failed: the oscillation enters the loop elsewhere" }
+                "R² {} without stiction, {} with a Stenman band of {} % of span, {} with a slip jump (Kano); \
+                 the stiction model explains {} % more of the PV's variation above its noise",
+                num(m.r2_without_stiction),
+                num(m.r2_stenman),
+                num(m.stenman_d_percent_of_span),
+                num(m.r2_slip_jump),
+                num(100.0 * m.improvement)
             ),
         ));
     }
@@ -977,18 +1036,18 @@ fn windows(h: &mut String, d: &Diagnosis) {
         let votes: Vec<String> = w
             .votes
             .iter()
-            .map(|(n, v)| format!("<code>{}</code> {}", esc(n), vote_chip(*v)))
+            .map(|(n, v)| format!("{} {}", esc(n.words()), vote_chip(*v)))
             .collect();
         let _ = write!(
             h,
             "<tr><td class=\"num\">{} to {}</td><td class=\"num\">{} to {}</td><td>{}</td>\
-             <td class=\"num\">{:.2}</td><td class=\"num\">{}</td><td>{}</td>",
+             <td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td>",
             w.start,
             w.end,
             num(w.t_start),
             num(w.t_end),
             verdict_chip(w.verdict),
-            w.confidence,
+            w.confidence.map_or("–".into(), |c| format!("{c:.2}")),
             w.period.map_or("–".into(), seconds),
             if votes.is_empty() {
                 "–".into()

@@ -1,4 +1,4 @@
-use crate::cmd_simulate::write_atomic;
+use crate::atomic::write_atomic;
 use crate::plot::{self, Chart, HBand, Kind, Series};
 use anyhow::{bail, Result};
 use std::path::{Path, PathBuf};

@@ -1,8 +1,11 @@
+// `report` and `estimate` still name the helper by this path
+pub use crate::atomic::write_atomic;
 use crate::spec;
-use anyhow::{bail, Context, Result};
-use std::io::Write;
+use crate::words::count;
+use anyhow::{bail, Result};
 use std::path::{Path, PathBuf};
 use stiction_core::sim::{simulate_open_loop, ClosedLoop, LoopData, Signal};
+use stiction_core::sim_check::{loop_health, LoopHealth, Stability, SATURATION_LIMIT};
 
 #[derive(clap::Args)]
 #[command(after_help = "Examples:
@@ -23,8 +26,9 @@ pub struct Args {
     params: Vec<String>,
     /// Open loop: the command signal: sine|triangle:amplitude=,period=,offset= ;
     /// random-walk:std=,offset=,seed= ; steps:amplitude=,hold=,offset=,seed= ; step:from=,to=,at= ; const:value=
-    #[arg(long, default_value = "sine:amplitude=1,period=10")]
-    signal: String,
+    /// [default: sine:amplitude=1,period=10]
+    #[arg(long)]
+    signal: Option<String>,
     /// Sampling time in seconds [default: 0.1 open loop, 1 closed loop]
     #[arg(long)]
     ts: Option<f64>,
@@ -38,17 +42,18 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Closed loop: the process, foptd:K=,tau=,delay= or integrating:K=,delay= (seconds)
-    #[arg(long, default_value = "foptd:K=3,tau=10,delay=10")]
-    process: String,
-    /// Closed loop: PI controller, Kc=,Ti= (Ti in seconds)
-    #[arg(long, default_value = "Kc=0.2,Ti=10")]
-    pi: String,
-    /// Closed loop: the setpoint signal (same forms as --signal)
-    #[arg(long, default_value = "step:from=50,to=51,at=10")]
-    sp: String,
-    /// Closed loop: controller output and valve position at the start, % of span
-    #[arg(long, default_value_t = 50.0)]
-    op0: f64,
+    /// [default: foptd:K=3,tau=10,delay=10]
+    #[arg(long)]
+    process: Option<String>,
+    /// Closed loop: PI controller, Kc=,Ti= (Ti in seconds) [default: Kc=0.2,Ti=10]
+    #[arg(long)]
+    pi: Option<String>,
+    /// Closed loop: the setpoint signal (same forms as --signal) [default: step:from=50,to=51,at=10]
+    #[arg(long)]
+    sp: Option<String>,
+    /// Closed loop: controller output and valve position at the start, % of span [default: 50]
+    #[arg(long)]
+    op0: Option<f64>,
     /// Closed loop: a disturbance added to pv (same forms as --signal), e.g. sine:amplitude=1,period=60
     #[arg(long)]
     disturbance: Option<String>,
@@ -75,11 +80,15 @@ pub fn run(a: Args) -> Result<()> {
             a.noise
         );
     }
+    check_loop_flags(&a, closed)?;
     let data = if closed {
         let mut cl = ClosedLoop::new(model);
-        cl.process = spec::process(&a.process)?;
-        cl.pi = spec::pi(&a.pi)?;
-        cl.setpoint = spec::signal(&a.sp, "--sp")?;
+        cl.process = spec::process(a.process.as_deref().unwrap_or("foptd:K=3,tau=10,delay=10"))?;
+        cl.pi = spec::pi(a.pi.as_deref().unwrap_or("Kc=0.2,Ti=10"))?;
+        cl.setpoint = spec::signal(
+            a.sp.as_deref().unwrap_or("step:from=50,to=51,at=10"),
+            "--sp",
+        )?;
         cl.disturbance = a
             .disturbance
             .as_deref()
@@ -89,17 +98,18 @@ pub fn run(a: Args) -> Result<()> {
         cl.samples = samples;
         cl.noise = a.noise;
         cl.seed = a.seed;
-        cl.op0 = a.op0;
+        cl.op0 = a.op0.unwrap_or(50.0);
         cl.run().map_err(|e| anyhow::anyhow!("closed loop: {e}"))?
     } else {
-        let signal: Signal = spec::signal(&a.signal, "--signal")?;
+        let text = a.signal.as_deref().unwrap_or("sine:amplitude=1,period=10");
+        let signal: Signal = spec::signal(text, "--signal")?;
         simulate_open_loop(&model, &signal, ts, samples, a.noise, a.seed)
             .map_err(|e| anyhow::anyhow!("open loop: {e}"))?
     };
     write_loop_csv(&a.output, &data)?;
+    let samples_text = count(samples, "sample", "samples");
     eprintln!(
-        "wrote {} samples ({} loop, {} {}) to {}",
-        samples,
+        "wrote {samples_text} ({} loop, {} {}) to {}",
         a.loop_kind,
         kind,
         kind.param_names()
@@ -110,11 +120,65 @@ pub fn run(a: Args) -> Result<()> {
             .join(" "),
         a.output.display()
     );
+    if let Some(h) = loop_health(&data) {
+        for w in health_warnings(&h) {
+            eprintln!("warning: {}: {w}", a.output.display());
+        }
+    }
     Ok(())
 }
 
-/// Write `t,sp,op,mv,pv` (empty cells where a loop has no such signal), atomically: a temporary
-/// file beside the target, then a rename.
+/// Flags of one kind of loop given for the other are an error, not silently ignored.
+fn check_loop_flags(a: &Args, closed: bool) -> Result<()> {
+    let closed_only = [
+        ("--process", a.process.is_some()),
+        ("--pi", a.pi.is_some()),
+        ("--sp", a.sp.is_some()),
+        ("--op0", a.op0.is_some()),
+        ("--disturbance", a.disturbance.is_some()),
+    ];
+    if !closed {
+        if let Some((flag, _)) = closed_only.iter().find(|(_, given)| *given) {
+            bail!("{flag} applies to a closed loop; add --loop closed, or leave {flag} out");
+        }
+    } else if a.signal.is_some() {
+        bail!("--signal drives an open loop; a closed loop follows --sp (the setpoint) and --disturbance");
+    }
+    Ok(())
+}
+
+/// Sentences for a loop that is unstable or saturated: data of either kind says little about
+/// the valve.
+fn health_warnings(h: &LoopHealth) -> Vec<String> {
+    let mut out = Vec::new();
+    match h.stability {
+        Stability::Stable => {}
+        Stability::Growing => out.push(format!(
+            "the loop is unstable: the control error's RMS grows {:.1}x from the second to the last quarter of the record; loosen the tuning (smaller Kc in --pi, larger Ti)",
+            h.growth.unwrap_or(f64::NAN)
+        )),
+        Stability::RunningAway => out.push(
+            "the loop is unstable: the PV runs away (beyond 1e6 or not a number); loosen the tuning (smaller Kc in --pi, larger Ti)".into(),
+        ),
+    }
+    let swings = h.saturated_low > 0.01 && h.saturated_high > 0.01;
+    if h.saturated() >= SATURATION_LIMIT && swings {
+        out.push(format!(
+            "OP swings between 0 and 100 % and sits at a limit {:.0} % of the time: the loop is unstable, held only by the valve's limits; loosen the tuning (smaller Kc in --pi, larger Ti)",
+            100.0 * h.saturated()
+        ));
+    } else if h.saturated() >= SATURATION_LIMIT {
+        out.push(format!(
+            "OP sits at {} % {:.0} % of the time: the loop cannot reach its setpoint there; move --sp or --op0 inside the valve's range, or change the process gain",
+            if h.saturated_low > h.saturated_high { 0 } else { 100 },
+            100.0 * h.saturated()
+        ));
+    }
+    out
+}
+
+/// Write `t,sp,op,mv,pv` (empty cells where a loop has no such signal), atomically
+/// ([`crate::atomic`]).
 pub fn write_loop_csv(path: &Path, d: &LoopData) -> Result<()> {
     let mut text = String::with_capacity(d.t.len() * 48);
     text.push_str("t,sp,op,mv,pv\n");
@@ -130,23 +194,4 @@ pub fn write_loop_csv(path: &Path, d: &LoopData) -> Result<()> {
         ));
     }
     write_atomic(path, text.as_bytes())
-}
-
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
-    }
-    let tmp = path.with_extension(format!(
-        "{}.tmp{}",
-        path.extension().and_then(|e| e.to_str()).unwrap_or(""),
-        std::process::id()
-    ));
-    let mut f = std::fs::File::create(&tmp)
-        .with_context(|| format!("{}: cannot write the file", path.display()))?;
-    f.write_all(bytes)
-        .with_context(|| format!("{}: cannot write the file", path.display()))?;
-    drop(f);
-    std::fs::rename(&tmp, path)
-        .with_context(|| format!("{}: cannot write the file", path.display()))
 }

@@ -83,30 +83,37 @@ pub fn save_panels(charts: &[Chart], stem: &Path) -> Result<Vec<PathBuf>> {
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
     let size = (1000, 600 * charts.len().max(1) as u32);
-    let bitmap = BitMapBackend::new(&png, size).into_drawing_area();
-    for (area, chart) in bitmap
-        .split_evenly((charts.len(), 1))
-        .into_iter()
-        .zip(charts)
+    // the PNG encoder writes to a path: it gets the atomic write's temporary file
+    crate::atomic::write_via(&png, |tmp| {
+        let bitmap = BitMapBackend::new(tmp, size).into_drawing_area();
+        for (area, chart) in bitmap
+            .split_evenly((charts.len(), 1))
+            .into_iter()
+            .zip(charts)
+        {
+            draw(area, chart)
+                .map_err(|e| anyhow!("{}: cannot draw the chart: {e}", png.display()))?;
+        }
+        bitmap
+            .present()
+            .map_err(|e| anyhow!("{}: cannot write the chart: {e}", png.display()))
+    })?;
+    let mut text = String::new();
     {
-        draw(area, chart).map_err(|e| anyhow!("{}: cannot draw the chart: {e}", png.display()))?;
+        let vector = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        for (area, chart) in vector
+            .split_evenly((charts.len(), 1))
+            .into_iter()
+            .zip(charts)
+        {
+            draw(area, chart)
+                .map_err(|e| anyhow!("{}: cannot draw the chart: {e}", svg.display()))?;
+        }
+        vector
+            .present()
+            .map_err(|e| anyhow!("{}: cannot write the chart: {e}", svg.display()))?;
     }
-    bitmap
-        .present()
-        .map_err(|e| anyhow!("{}: cannot write the chart: {e}", png.display()))?;
-    drop(bitmap);
-    let vector = SVGBackend::new(&svg, size).into_drawing_area();
-    for (area, chart) in vector
-        .split_evenly((charts.len(), 1))
-        .into_iter()
-        .zip(charts)
-    {
-        draw(area, chart).map_err(|e| anyhow!("{}: cannot draw the chart: {e}", svg.display()))?;
-    }
-    vector
-        .present()
-        .map_err(|e| anyhow!("{}: cannot write the chart: {e}", svg.display()))?;
-    drop(vector);
+    crate::atomic::write_atomic(&svg, text.as_bytes())?;
     Ok(vec![png, svg])
 }
 

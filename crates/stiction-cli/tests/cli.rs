@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{closed_stenman, fails, json, ok};
+use common::{closed_stenman, fails, json, ok, stiction};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
@@ -305,14 +305,18 @@ fn non_numeric_nan_and_infinite_cells() {
         &["estimate", &f],
         &["b.csv", "line 9", "column 'op'", "'abc'", "not a number"],
     );
+    // NaN is a gap: the longest stretch without one is used, and a note says so
     let f = write(
         dir.path(),
         "c.csv",
         &good_rows(20).replacen("7,2,1", "7,2,NaN", 1),
     );
-    fails(
-        &["estimate", &f],
-        &["c.csv", "line 9", "column 'mv'", "finite"],
+    let err = ok(&["estimate", &f]);
+    assert!(
+        err.contains("  note: 1 cell treated as missing (mv 1")
+            && err.contains("using line 10 to 21")
+            && err.contains("12 samples of 20"),
+        "{err}"
     );
     let f = write(
         dir.path(),
@@ -330,20 +334,29 @@ fn too_few_samples_different_lengths_and_constant_command() {
     let dir = tmp();
     let f = write(dir.path(), "short.csv", &good_rows(6));
     fails(&["estimate", &f], &["short.csv", "6 rows", "at least 10"]);
-    // mv stops early: the last rows have no mv
+    // mv stops early: the last rows have no mv, a gap at the end; the rows before are used
     let mut text = good_rows(20);
     for k in 20..25 {
         text.push_str(&format!("{k},1,\n"));
     }
     let f = write(dir.path(), "ragged.csv", &text);
+    let out = stiction(&["estimate", &f, "--json"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(json(&String::from_utf8_lossy(&out.stdout))["samples"], 20);
+    assert!(err.contains("5 cells treated as missing (mv 5"), "{err}");
+    // gaps that leave no stretch long enough: refused in one sentence saying how long it must be
+    let text = good_rows(20)
+        .replacen("7,2,1", "7,,1", 1)
+        .replacen("14,4,2", "14,Bad Input,2", 1);
+    let f = write(dir.path(), "holes.csv", &text);
     fails(
         &["estimate", &f],
         &[
-            "ragged.csv",
-            "column 'mv'",
-            "20 values",
-            "25 rows",
-            "different lengths",
+            "holes.csv",
+            "no stretch of at least 10 samples",
+            "2 cells treated as missing: op 2",
+            "the longest stretch without gaps is 7 samples, line 2 to 8",
         ],
     );
     let mut text = String::from("t,op,mv\n");
@@ -352,15 +365,6 @@ fn too_few_samples_different_lengths_and_constant_command() {
     }
     let f = write(dir.path(), "flat.csv", &text);
     fails(&["estimate", &f], &["flat.csv", "column 'op'", "constant"]);
-    let f = write(
-        dir.path(),
-        "hole.csv",
-        &good_rows(20).replacen("7,2,1", "7,,1", 1),
-    );
-    fails(
-        &["estimate", &f],
-        &["hole.csv", "line 9", "column 'op'", "empty"],
-    );
 }
 
 #[test]

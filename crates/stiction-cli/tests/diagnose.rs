@@ -39,22 +39,39 @@ fn a_sticky_loop_is_stiction_with_the_band_sized() {
         .collect();
     assert!(names.contains(&"cross_correlation") && names.contains(&"curve_fitting"));
     assert!(names.contains(&"harmonics") && names.contains(&"shape"));
-    // the valve drives this oscillation: the closed-loop check passes
-    assert_eq!(v["closed_loop_check"]["passed"], true, "{v:#}");
-    assert!(v["closed_loop_check"]["explained"].as_f64().unwrap() > 0.9);
+    // every family reports its value, threshold and vote; the fit with stiction votes for it
+    let families = v["families"].as_array().unwrap();
+    for name in ["valve", "model", "stick_slip", "shape", "loop"] {
+        let f = families.iter().find(|f| f["family"] == name).unwrap();
+        assert!(f["threshold"].as_str().is_some() && f["vote"].as_str().is_some());
+    }
+    // a regular limit cycle is fitted about as well without stiction: the fits do not vote
+    // against the valve, the loop family (the cycle the linear loop cannot sustain) votes for it
+    let model = families.iter().find(|f| f["family"] == "model").unwrap();
+    assert_ne!(model["vote"], "no_stiction", "{model:#}");
+    assert!(
+        model["model"]["r2_stenman"].as_f64().unwrap() > 0.9,
+        "{model:#}"
+    );
+    let lp = families.iter().find(|f| f["family"] == "loop").unwrap();
+    assert_eq!(lp["vote"], "stiction", "{lp:#}");
     for i in v["indices"].as_array().unwrap() {
         assert!(i["threshold"].as_str().is_some() && i["vote"].as_str().is_some());
     }
-    let d = v["apparent_stiction"]["closed_loop"].as_f64().unwrap();
-    assert!(d > 0.5 && d < 4.0, "closed-loop band {d}");
+    let d = v["band"]["band_percent_of_span"].as_f64().unwrap();
+    assert!(d > 0.5 && d < 4.0, "band {d}");
+    assert_eq!(v["band"]["source"], "closed_loop");
+    assert!(v["next_step"].as_str().unwrap().contains("valve"), "{v:#}");
     assert!(v["oscillation"]["period"].as_f64().unwrap() > 10.0);
     // the human printer says the same
     let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
     assert!(text.contains("STICTION"), "{text}");
     assert!(text.contains("cross_correlation"), "{text}");
-    assert!(!text.contains("closed-loop check"), "{text}");
+    assert!(text.contains("closed-loop fit's scan"), "{text}");
     let text = ok(&["diagnose", &f, "--sp", "sp"]);
-    assert!(text.contains("closed-loop check: OP explains"), "{text}");
+    assert!(text.contains("closed-loop fit: R²"), "{text}");
+    assert!(text.contains("% of valve span"), "{text}");
+    assert!(text.contains("next step:"), "{text}");
     assert_eq!(v["quantification"]["valve_start_kind"], "first_op");
     let v = json(&ok(&[
         "diagnose",
@@ -159,14 +176,22 @@ fn historian_exports_with_timestamps_decimal_commas_and_a_mode_column() {
     assert_eq!(v["verdict"], "insufficient_data");
     assert!(v["reason"].as_str().unwrap().contains("manual"), "{v:#}");
 
-    // a gap in the time axis
+    // a gap in the time axis splits the record; the longer stretch is judged
     let g = historian(dir.path(), 0, Some(700));
     let mut args = vec!["diagnose", &g];
     args.extend_from_slice(&cols);
     args.push("--json");
     let v = json(&ok(&args));
-    assert_eq!(v["verdict"], "insufficient_data");
-    assert!(v["reason"].as_str().unwrap().contains("gap"), "{v:#}");
+    assert_eq!(v["stretches"].as_array().unwrap().len(), 2, "{v:#}");
+    assert!(
+        v["quality"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f["gate"] == "time_gaps"),
+        "{v:#}"
+    );
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
 }
 
 #[test]

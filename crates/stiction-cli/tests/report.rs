@@ -90,9 +90,10 @@ fn report_of_a_sticky_loop_is_self_contained() {
         assert!(html.contains(section), "{section}");
     }
     // the estimate, the model overlay, the estimator and the caveat
-    assert!(html.contains("Closed-loop estimate (Stenman d)"));
-    assert!(html.contains("Closed-loop check: does OP drive the oscillation?"));
-    assert!(html.contains("<strong>passed</strong>"));
+    assert!(html.contains("Stiction band"));
+    assert!(html.contains("Closed-loop fit with and without stiction"));
+    assert!(html.contains("<th>Family</th>"), "the families of evidence");
+    assert!(html.contains("% of valve span</strong>"));
     assert!(html.contains("Valve position at the first sample"));
     assert!(html.contains("optimal set"));
     assert!(html.contains("estimated MV"));
@@ -101,7 +102,7 @@ fn report_of_a_sticky_loop_is_self_contained() {
     assert!(html.contains("proven over every distinct valve trajectory"));
     assert!(html.contains("each cell of the whole record lies inside"));
     assert!(html.contains("without the valve position"));
-    assert!(html.contains("<code>op_saturated</code>"));
+    assert!(html.contains("<code>record_length</code>"));
 
     let svgs = html.matches("<svg").count();
     assert!(svgs >= 2, "{svgs} inline SVGs");
