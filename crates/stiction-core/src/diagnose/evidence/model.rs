@@ -34,6 +34,16 @@ pub const SIGNIFICANCE_NONE: f64 = 3.0;
 pub const MIN_EXPLAINED: f64 = 0.3;
 /// Strength of the weak vote against stiction.
 const NONE_STRENGTH: f64 = 0.25;
+/// A cycle at least this regular (Thornhill's regularity: mean period over three standard
+/// deviations of the periods) is a limit cycle, whose fits with and without stiction look alike
+/// (the fits see a few harmonics of it); a routine record's noise and drifts stay below it.
+const LIMIT_CYCLE_REGULARITY: f64 = 10.0;
+
+/// The loop limit-cycles: it oscillates, regularly.
+fn limit_cycles(ctx: &Context) -> bool {
+    let o = &ctx.oscillation;
+    o.oscillating && o.regularity.regularity >= LIMIT_CYCLE_REGULARITY
+}
 /// Strength of a vote against stiction when OP does not drive PV.
 const ELSEWHERE_STRENGTH: f64 = 0.9;
 /// Fewest independent changes (samples over the lag) for the test.
@@ -125,7 +135,7 @@ impl EvidenceFamily for Model {
             "improvement of the fit with stiction over the linear loop, share of the PV's variance above its noise";
         let threshold = format!(
             "stiction when the improvement, held against the stiction fit's residual per independent change, reaches {SIGNIFICANCE_STICTION} \
-             (about the 95th percentile of simulated healthy loops); none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles, or when OP explains under {:.0} % \
+             (about the 95th percentile of simulated healthy loops); none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more), or when OP explains under {:.0} % \
              of the PV's variation above its noise",
             100.0 * MIN_EXPLAINED
         );
@@ -217,7 +227,7 @@ impl EvidenceFamily for Model {
                     100.0 * improvement
                 ),
             )
-        } else if significance <= SIGNIFICANCE_NONE && ctx.oscillation.oscillating {
+        } else if significance <= SIGNIFICANCE_NONE && limit_cycles(ctx) {
             // a regular cycle is a few harmonics: linear dynamics from OP fit it about as well as
             // the valve that causes it, so fits alike are no evidence either way
             (
