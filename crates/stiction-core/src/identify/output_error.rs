@@ -1,0 +1,306 @@
+//! Output-error refinement of an equation-error fit: Steiglitz-McBride iterations and a
+//! Levenberg-Marquardt polish on the simulation error.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::*;
+
+pub(super) const MAX_P: usize = 8;
+
+/// `x` filtered by `1 / A(q)`, `A(q) = 1 - a_1 q^-1 - ... - a_na q^-na` (zero initial state).
+pub(super) fn inverse_filter(x: &[f64], a: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; x.len()];
+    for t in 0..x.len() {
+        let mut v = x[t];
+        for (i, ai) in a.iter().enumerate() {
+            if t > i {
+                v += ai * out[t - 1 - i];
+            }
+        }
+        out[t] = v;
+    }
+    out
+}
+
+/// Move a fit towards the output-error optimum (Steiglitz and McBride 1965): the output and the
+/// valve position are filtered by `1 / A(q)` of the current fit and the structure refitted by
+/// least squares, `iterations` times. An equation-error fit of noisy closed-loop data is biased,
+/// so its simulation can be much worse than the best linear model's; comparisons of simulation
+/// errors (with and without stiction) need both near their own optimum. Returns the iterate of
+/// least simulation error (the iteration need not decrease it), the start included.
+pub fn refine_output_error(data: &Data, mv: &[f64], start: &Fit, iterations: usize) -> Fit {
+    let s = start.structure;
+    let mut best = start.clone();
+    if s.na == 0 {
+        // no output lags: least squares is already the output-error fit
+        return best;
+    }
+    let y = data.y(s.integrating);
+    let (t0, n) = (data.t0, y.len());
+    let p = s.na + s.nb + 1;
+    let mut a = start.a.clone();
+    for _ in 0..iterations {
+        let yf = inverse_filter(y, &a);
+        let mf = inverse_filter(mv, &a);
+        let mut g = [[0.0f64; MAX_P]; MAX_P];
+        let mut h = [0.0f64; MAX_P];
+        let mut row = [0.0f64; MAX_P];
+        for t in t0..n {
+            for i in 0..s.na {
+                row[i] = yf[t - 1 - i];
+            }
+            for j in 0..s.nb {
+                row[s.na + j] = mf[t - s.nk - j];
+            }
+            row[p - 1] = 1.0;
+            for i in 0..p {
+                h[i] += row[i] * yf[t];
+                for j in i..p {
+                    g[i][j] += row[i] * row[j];
+                }
+            }
+        }
+        let Some(theta) = solve(&g, &h, p) else {
+            break;
+        };
+        let a_new = theta[..s.na].to_vec();
+        let b_new = theta[s.na..s.na + s.nb].to_vec();
+        // the filtered constant is the model's constant over A(1)
+        let c = theta[p - 1] * (1.0 - a.iter().sum::<f64>());
+        let candidate = Fit {
+            structure: s,
+            a: a_new.clone(),
+            b: b_new.clone(),
+            c,
+            sse_one_step: one_step_sse(y, mv, s, &a_new, &b_new, c, t0),
+            sse_simulation: simulate_sse(y, mv, s, &a_new, &b_new, c, t0, None),
+            sst: start.sst,
+        };
+        if !candidate.stable() {
+            break;
+        }
+        if candidate.sse_simulation < best.sse_simulation {
+            best = candidate;
+        }
+        a = a_new;
+    }
+    best
+}
+
+/// Polish the coefficients of `start` (another fit's, e.g. of another valve trajectory) on
+/// `mv`'s simulation error by Levenberg-Marquardt. `None` when they do not simulate `mv` stably.
+pub fn polish_output_error(data: &Data, mv: &[f64], start: &Fit) -> Option<Fit> {
+    let s = start.structure;
+    let y = data.y(s.integrating);
+    let t0 = data.t0;
+    let sse = simulate_sse(y, mv, s, &start.a, &start.b, start.c, t0, None);
+    if !sse.is_finite() || !start.stable() {
+        return None;
+    }
+    let begin = Fit {
+        sse_simulation: sse,
+        sse_one_step: one_step_sse(y, mv, s, &start.a, &start.b, start.c, t0),
+        ..start.clone()
+    };
+    Some(levenberg_marquardt(y, mv, t0, begin, LM_ITERATIONS))
+}
+
+/// Levenberg-Marquardt iterations on the simulation error after Steiglitz-McBride.
+pub(super) const LM_ITERATIONS: usize = 12;
+
+/// Polish a fit on its simulation (output-error) criterion by Levenberg-Marquardt with a
+/// forward-difference Jacobian (Marquardt 1963): Steiglitz-McBride can stop far from the optimum
+/// when the valve position is noisy (closed-loop data), and a comparison of fits is only fair at
+/// both optima. Keeps stable, better iterates only.
+pub(super) fn levenberg_marquardt(
+    y: &[f64],
+    mv: &[f64],
+    t0: usize,
+    start: Fit,
+    iterations: usize,
+) -> Fit {
+    let s = start.structure;
+    let p = s.na + s.nb + 1;
+    let pack = |f: &Fit| -> Vec<f64> {
+        f.a.iter()
+            .chain(&f.b)
+            .copied()
+            .chain(std::iter::once(f.c))
+            .collect()
+    };
+    let unpack = |theta: &[f64]| -> (Vec<f64>, Vec<f64>, f64) {
+        (
+            theta[..s.na].to_vec(),
+            theta[s.na..s.na + s.nb].to_vec(),
+            theta[p - 1],
+        )
+    };
+    let residuals = |theta: &[f64], out: &mut Vec<f64>| -> f64 {
+        let (a, b, c) = unpack(theta);
+        let mut sim = Vec::with_capacity(y.len());
+        let sse = simulate_sse(y, mv, s, &a, &b, c, t0, Some(&mut sim));
+        out.clear();
+        out.extend(y[t0..].iter().zip(&sim[t0..]).map(|(a, b)| a - b));
+        sse
+    };
+    let mut theta = pack(&start);
+    let mut r = Vec::new();
+    let mut sse = residuals(&theta, &mut r);
+    if !sse.is_finite() {
+        return start;
+    }
+    let m = r.len();
+    let mut lambda = 1e-3;
+    let mut jac = vec![0.0; m * p];
+    let mut rk = Vec::new();
+    for _ in 0..iterations {
+        for k in 0..p {
+            let h = 1e-6 * theta[k].abs().max(1e-3);
+            let mut t = theta.clone();
+            t[k] += h;
+            if !residuals(&t, &mut rk).is_finite() {
+                return best_of(start, y, mv, t0, &theta, sse);
+            }
+            for i in 0..m {
+                jac[i * p + k] = (r[i] - rk[i]) / h;
+            }
+        }
+        let mut g = [[0.0f64; MAX_P]; MAX_P];
+        let mut h = [0.0f64; MAX_P];
+        for i in 0..m {
+            let row = &jac[i * p..(i + 1) * p];
+            for a in 0..p {
+                h[a] += row[a] * r[i];
+                for b in a..p {
+                    g[a][b] += row[a] * row[b];
+                }
+            }
+        }
+        let mut improved = false;
+        for _ in 0..6 {
+            let mut gl = g;
+            for a in 0..p {
+                gl[a][a] += lambda * g[a][a].max(1e-12);
+            }
+            let Some(step) = solve(&gl, &h, p) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let trial: Vec<f64> = (0..p).map(|k| theta[k] + step[k]).collect();
+            let (a, _, _) = unpack(&trial);
+            let stable = Fit { a, ..start.clone() }.stable();
+            let trial_sse = if stable {
+                residuals(&trial, &mut rk)
+            } else {
+                f64::INFINITY
+            };
+            if trial_sse < sse {
+                theta = trial;
+                sse = trial_sse;
+                std::mem::swap(&mut r, &mut rk);
+                lambda = (lambda * 0.3).max(1e-9);
+                improved = true;
+                break;
+            }
+            lambda *= 10.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    best_of(start, y, mv, t0, &theta, sse)
+}
+
+/// The start or the polished parameters, whichever simulates better.
+pub(super) fn best_of(
+    start: Fit,
+    y: &[f64],
+    mv: &[f64],
+    t0: usize,
+    theta: &[f64],
+    sse: f64,
+) -> Fit {
+    if sse.is_nan() || sse >= start.sse_simulation {
+        return start;
+    }
+    let s = start.structure;
+    let p = s.na + s.nb + 1;
+    let (a, b, c) = (
+        theta[..s.na].to_vec(),
+        theta[s.na..s.na + s.nb].to_vec(),
+        theta[p - 1],
+    );
+    Fit {
+        sse_one_step: one_step_sse(y, mv, s, &a, &b, c, t0),
+        sse_simulation: sse,
+        a,
+        b,
+        c,
+        ..start
+    }
+}
+
+/// One-step prediction error sum of squares of an ARX model over `t0..`.
+pub(super) fn one_step_sse(
+    y: &[f64],
+    mv: &[f64],
+    s: Structure,
+    a: &[f64],
+    b: &[f64],
+    c: f64,
+    t0: usize,
+) -> f64 {
+    (t0..y.len())
+        .map(|t| {
+            let mut v = c;
+            for (i, ai) in a.iter().enumerate() {
+                v += ai * y[t - 1 - i];
+            }
+            for (j, bj) in b.iter().enumerate() {
+                v += bj * mv[t - s.nk - j];
+            }
+            (y[t] - v).powi(2)
+        })
+        .sum()
+}
+
+/// Cholesky solve of the upper-triangular-stored normal equations, with a tiny ridge.
+pub(super) fn solve(g: &[[f64; MAX_P]; MAX_P], h: &[f64; MAX_P], p: usize) -> Option<[f64; MAX_P]> {
+    let trace: f64 = (0..p).map(|i| g[i][i]).sum();
+    let ridge = 1e-12 * trace.max(f64::MIN_POSITIVE);
+    // L L' = G, L stored in the lower triangle of `l`
+    let mut l = [[0.0f64; MAX_P]; MAX_P];
+    for i in 0..p {
+        for j in 0..=i {
+            let mut sum = g[j][i] + if i == j { ridge } else { 0.0 };
+            for k in 0..j {
+                sum -= l[i][k] * l[j][k];
+            }
+            if i == j {
+                if sum <= 1e-14 * trace.max(1e-300) {
+                    return None;
+                }
+                l[i][i] = sum.sqrt();
+            } else {
+                l[i][j] = sum / l[j][j];
+            }
+        }
+    }
+    let mut w = [0.0f64; MAX_P];
+    for i in 0..p {
+        let mut sum = h[i];
+        for k in 0..i {
+            sum -= l[i][k] * w[k];
+        }
+        w[i] = sum / l[i][i];
+    }
+    let mut x = [0.0f64; MAX_P];
+    for i in (0..p).rev() {
+        let mut sum = w[i];
+        for k in i + 1..p {
+            sum -= l[k][i] * x[k];
+        }
+        x[i] = sum / l[i][i];
+    }
+    Some(x)
+}

@@ -1,0 +1,238 @@
+//! Least-squares fits of one structure: the PV's sums computed once, each valve trajectory's
+//! sums and simulation per call.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::*;
+
+/// The sums of a least-squares fit that involve the valve position.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ValveSums {
+    mm: [[f64; 2]; 2],
+    ym: [[f64; 2]; 2],
+    m1: [f64; 2],
+    hm: [f64; 2],
+}
+
+/// Everything of a fit that depends only on the PV, computed once per structure: the many valve
+/// trajectories a search tries then cost one pass each for their own sums and one simulation.
+pub struct Prepared<'a> {
+    y: &'a [f64],
+    s: Structure,
+    t0: usize,
+    /// sums over the used samples: y-lag x y-lag, y-lag, y x y-lag, y x y
+    yy_lags: [[f64; 2]; 2],
+    y_lags: [f64; 2],
+    y_y_lags: [f64; 2],
+    yy: f64,
+    y_sum: f64,
+    count: f64,
+}
+
+impl<'a> Prepared<'a> {
+    pub fn new(data: &'a Data, s: Structure) -> Self {
+        assert!(s.na <= 2 && s.nb <= 2 && s.nk >= 1);
+        let y = data.y(s.integrating);
+        let t0 = data.t0;
+        let mut yy_lags = [[0.0; 2]; 2];
+        let mut y_lags = [0.0; 2];
+        let mut y_y_lags = [0.0; 2];
+        let mut yy = 0.0;
+        for t in t0..y.len() {
+            for i in 0..s.na {
+                let yi = y[t - 1 - i];
+                y_lags[i] += yi;
+                y_y_lags[i] += y[t] * yi;
+                for j in i..s.na {
+                    yy_lags[i][j] += yi * y[t - 1 - j];
+                }
+            }
+            yy += y[t] * y[t];
+        }
+        Self {
+            y,
+            s,
+            t0,
+            yy_lags,
+            y_lags,
+            y_y_lags,
+            yy,
+            y_sum: y[t0..].iter().sum(),
+            count: y.len().saturating_sub(t0) as f64,
+        }
+    }
+
+    pub fn structure(&self) -> Structure {
+        self.s
+    }
+
+    /// Least squares and simulation for one valve trajectory.
+    pub fn fit(&self, mv: &[f64]) -> Option<Fit> {
+        self.fit_bounded(mv, f64::INFINITY)
+    }
+
+    /// As [`Prepared::fit`], but the simulation stops as soon as its error exceeds `bound`
+    /// (the fit can then not be the best, and its `sse_simulation` is infinite).
+    pub fn fit_bounded(&self, mv: &[f64], bound: f64) -> Option<Fit> {
+        // the orders are compile-time constants inside, so the loops unroll
+        match (self.s.na, self.s.nb) {
+            (0, 1) => self.fit_n::<0, 1>(mv, bound),
+            (0, 2) => self.fit_n::<0, 2>(mv, bound),
+            (1, 1) => self.fit_n::<1, 1>(mv, bound),
+            (1, 2) => self.fit_n::<1, 2>(mv, bound),
+            (2, 1) => self.fit_n::<2, 1>(mv, bound),
+            (2, 2) => self.fit_n::<2, 2>(mv, bound),
+            _ => unreachable!("orders are checked when prepared"),
+        }
+    }
+
+    fn fit_n<const NA: usize, const NB: usize>(&self, mv: &[f64], bound: f64) -> Option<Fit> {
+        let sums = self.sums_n::<NA, NB>(mv);
+        self.finish_n::<NA, NB>(&sums, mv, bound)
+    }
+
+    /// The valve's own sums for a whole trajectory.
+    pub fn sums(&self, mv: &[f64]) -> ValveSums {
+        match (self.s.na, self.s.nb) {
+            (0, 1) => self.sums_n::<0, 1>(mv),
+            (0, 2) => self.sums_n::<0, 2>(mv),
+            (1, 1) => self.sums_n::<1, 1>(mv),
+            (1, 2) => self.sums_n::<1, 2>(mv),
+            (2, 1) => self.sums_n::<2, 1>(mv),
+            (2, 2) => self.sums_n::<2, 2>(mv),
+            _ => unreachable!("orders are checked when prepared"),
+        }
+    }
+
+    /// Bring `sums` from trajectory `old` to `new`, which differ only at the samples `changed`
+    /// (sorted): only the regression rows that see a changed sample are touched.
+    pub fn update_sums(
+        &self,
+        sums: &mut ValveSums,
+        old: &[f64],
+        new: &[f64],
+        changed: &[usize],
+        rows: &mut Vec<usize>,
+    ) {
+        let (s, y, t0, n) = (self.s, self.y, self.t0, self.y.len());
+        rows.clear();
+        for &i in changed {
+            for j in 0..s.nb {
+                let t = i + s.nk + j;
+                if t >= t0 && t < n {
+                    rows.push(t);
+                }
+            }
+        }
+        rows.sort_unstable();
+        rows.dedup();
+        for &t in rows.iter() {
+            for (mv, sign) in [(old, -1.0), (new, 1.0)] {
+                let m = [mv[t - s.nk], if s.nb > 1 { mv[t - s.nk - 1] } else { 0.0 }];
+                for j in 0..s.nb {
+                    sums.m1[j] += sign * m[j];
+                    sums.hm[j] += sign * y[t] * m[j];
+                    for k in j..s.nb {
+                        sums.mm[j][k] += sign * m[j] * m[k];
+                    }
+                    for i in 0..s.na {
+                        sums.ym[i][j] += sign * y[t - 1 - i] * m[j];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Least squares from the sums, then the simulation (stopped once its error exceeds `bound`).
+    pub fn fit_from_sums(&self, sums: &ValveSums, mv: &[f64], bound: f64) -> Option<Fit> {
+        match (self.s.na, self.s.nb) {
+            (0, 1) => self.finish_n::<0, 1>(sums, mv, bound),
+            (0, 2) => self.finish_n::<0, 2>(sums, mv, bound),
+            (1, 1) => self.finish_n::<1, 1>(sums, mv, bound),
+            (1, 2) => self.finish_n::<1, 2>(sums, mv, bound),
+            (2, 1) => self.finish_n::<2, 1>(sums, mv, bound),
+            (2, 2) => self.finish_n::<2, 2>(sums, mv, bound),
+            _ => unreachable!("orders are checked when prepared"),
+        }
+    }
+
+    fn sums_n<const NA: usize, const NB: usize>(&self, mv: &[f64]) -> ValveSums {
+        let (s, y, t0) = (self.s, self.y, self.t0);
+        let nk = s.nk;
+        // the valve's own sums: mv-lag x mv-lag, y-lag x mv-lag, mv-lag, y x mv-lag
+        let mut mm = [[0.0f64; 2]; 2];
+        let mut ym = [[0.0f64; 2]; 2];
+        let mut m1 = [0.0f64; 2];
+        let mut hm = [0.0f64; 2];
+        // lagged views of equal length, so the loop runs without bounds checks
+        let len = y.len() - t0;
+        let target = &y[t0..t0 + len];
+        let ms: [&[f64]; NB] = std::array::from_fn(|j| &mv[t0 - nk - j..t0 - nk - j + len]);
+        let ys: [&[f64]; NA] = std::array::from_fn(|i| &y[t0 - 1 - i..t0 - 1 - i + len]);
+        for k in 0..len {
+            let m: [f64; NB] = std::array::from_fn(|j| ms[j][k]);
+            let yl: [f64; NA] = std::array::from_fn(|i| ys[i][k]);
+            let target = target[k];
+            for j in 0..NB {
+                m1[j] += m[j];
+                hm[j] += target * m[j];
+                for k in j..NB {
+                    mm[j][k] += m[j] * m[k];
+                }
+                for i in 0..NA {
+                    ym[i][j] += yl[i] * m[j];
+                }
+            }
+        }
+        ValveSums { mm, ym, m1, hm }
+    }
+
+    fn finish_n<const NA: usize, const NB: usize>(
+        &self,
+        sums: &ValveSums,
+        mv: &[f64],
+        bound: f64,
+    ) -> Option<Fit> {
+        let (s, y, t0) = (self.s, self.y, self.t0);
+        let nk = s.nk;
+        let ValveSums { mm, ym, m1, hm } = *sums;
+        // assemble [y-lags, mv-lags, 1] (upper triangle)
+        let p = NA + NB + 1;
+        let mut g = [[0.0f64; MAX_P]; MAX_P];
+        let mut h = [0.0f64; MAX_P];
+        for i in 0..NA {
+            for j in i..NA {
+                g[i][j] = self.yy_lags[i][j];
+            }
+            for j in 0..NB {
+                g[i][NA + j] = ym[i][j];
+            }
+            g[i][p - 1] = self.y_lags[i];
+            h[i] = self.y_y_lags[i];
+        }
+        for j in 0..NB {
+            for k in j..NB {
+                g[NA + j][NA + k] = mm[j][k];
+            }
+            g[NA + j][p - 1] = m1[j];
+            h[NA + j] = hm[j];
+        }
+        g[p - 1][p - 1] = self.count;
+        h[p - 1] = self.y_sum;
+        let theta = solve(&g, &h, p)?;
+        let sse_one_step = (self.yy - (0..p).map(|i| theta[i] * h[i]).sum::<f64>()).max(0.0);
+        let a: [f64; NA] = std::array::from_fn(|i| theta[i]);
+        let b: [f64; NB] = std::array::from_fn(|j| theta[NA + j]);
+        let c = theta[p - 1];
+        let sse_simulation = simulate_n::<NA, NB>(y, mv, nk, &a, &b, c, t0, None, bound);
+        Some(Fit {
+            structure: s,
+            a: a.to_vec(),
+            b: b.to_vec(),
+            c,
+            sse_one_step,
+            sse_simulation,
+            sst: self.yy.max(f64::MIN_POSITIVE),
+        })
+    }
+}

@@ -1,0 +1,145 @@
+//! Output-error simulation of a fitted model.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::*;
+
+/// Output-error simulation from the measured initial conditions; returns the error sum of squares
+/// over `t0..` (infinite when the model diverges). Writes the simulated output when asked.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn simulate_sse(
+    y: &[f64],
+    mv: &[f64],
+    s: Structure,
+    a: &[f64],
+    b: &[f64],
+    c: f64,
+    t0: usize,
+    out: Option<&mut Vec<f64>>,
+) -> f64 {
+    macro_rules! go {
+        ($na:literal, $nb:literal) => {
+            simulate_n::<$na, $nb>(
+                y,
+                mv,
+                s.nk,
+                &std::array::from_fn(|i| a[i]),
+                &std::array::from_fn(|j| b[j]),
+                c,
+                t0,
+                out,
+                f64::INFINITY,
+            )
+        };
+    }
+    match (s.na, s.nb) {
+        (0, 1) => go!(0, 1),
+        (0, 2) => go!(0, 2),
+        (1, 1) => go!(1, 1),
+        (1, 2) => go!(1, 2),
+        (2, 1) => go!(2, 1),
+        (2, 2) => go!(2, 2),
+        _ => unreachable!("orders are at most 2"),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(super) fn simulate_n<const NA: usize, const NB: usize>(
+    y: &[f64],
+    mv: &[f64],
+    nk: usize,
+    a: &[f64; NA],
+    b: &[f64; NB],
+    c: f64,
+    t0: usize,
+    mut out: Option<&mut Vec<f64>>,
+    bound: f64,
+) -> f64 {
+    let n = y.len();
+    // the last NA simulated outputs, newest first
+    let mut sim: [f64; NA] = std::array::from_fn(|i| y[t0 - 1 - i]);
+    if let Some(o) = out.as_deref_mut() {
+        o.clear();
+        o.extend_from_slice(&y[..t0]);
+    }
+    let mut sse = 0.0;
+    let len = n - t0;
+    let ms: [&[f64]; NB] = std::array::from_fn(|j| &mv[t0 - nk - j..t0 - nk - j + len]);
+    let target = &y[t0..n];
+    for k in 0..len {
+        // everything but the newest simulated output first: the recursion's critical path is
+        // then one multiply-add per sample
+        let mut v = c;
+        for j in 0..NB {
+            v += b[j] * ms[j][k];
+        }
+        for i in (1..NA).rev() {
+            v += a[i] * sim[i];
+        }
+        if NA > 0 {
+            v += a[0] * sim[0];
+        }
+        for i in (1..NA).rev() {
+            sim[i] = sim[i - 1];
+        }
+        if NA > 0 {
+            sim[0] = v;
+        }
+        let e = target[k] - v;
+        sse += e * e;
+        if let Some(o) = out.as_deref_mut() {
+            o.push(v);
+        }
+        // checked every 64 samples: cheap, and most wrong trajectories are out within a few hundred
+        if k % 64 == 63 && sse > bound {
+            return f64::INFINITY;
+        }
+    }
+    if sse.is_finite() {
+        sse
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The simulated PV of a fit (for plots): integrating fits are integrated back from the measured
+/// PV at `t0`.
+pub fn simulate_pv(data: &Data, mv: &[f64], f: &Fit) -> Vec<f64> {
+    let s = f.structure;
+    let y = data.y(s.integrating);
+    let mut out = Vec::with_capacity(y.len());
+    simulate_sse(y, mv, s, &f.a, &f.b, f.c, data.t0, Some(&mut out));
+    if s.integrating {
+        let mut pv = data.pv[..data.t0].to_vec();
+        let mut level = data.pv[data.t0 - 1];
+        for &d in &out[data.t0..] {
+            level += d + data.mean_diff;
+            pv.push(level);
+        }
+        pv
+    } else {
+        out.iter().map(|v| v + data.mean_level).collect()
+    }
+}
+
+/// A dot product with four running sums: the additions of one sum wait for each other, four
+/// sums keep the pipeline full (the order is fixed, so the result is reproducible).
+pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let chunks = n / 4;
+    for k in 0..chunks {
+        let i = 4 * k;
+        acc[0] += a[i] * b[i];
+        acc[1] += a[i + 1] * b[i + 1];
+        acc[2] += a[i + 2] * b[i + 2];
+        acc[3] += a[i + 3] * b[i + 3];
+    }
+    let mut tail = 0.0;
+    for i in 4 * chunks..n {
+        tail += a[i] * b[i];
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
