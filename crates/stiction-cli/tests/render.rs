@@ -292,12 +292,23 @@ fn the_fleet_page_fits_a_phone_in_headless_chromium() {
     let dir = tempfile::tempdir().unwrap();
     let out = fleet(dir.path());
     // the page in a 390 px frame (a headless window is at least 500 px wide); once loaded, the
-    // frame's document writes its layout width into the DOM
-    let probe = "<!DOCTYPE html><html><body style=\"margin:0\">\
-        <iframe src=\"index.html\" style=\"width:390px;height:900px;border:0\" \
-        onload=\"var e=this.contentDocument.documentElement;\
-        document.body.setAttribute('data-scroll-width', e.scrollWidth);\
-        document.body.setAttribute('data-client-width', e.clientWidth);\"></iframe></body></html>";
+    // frame's document writes its layout width into the DOM, then the script sorts by loop name
+    // and filters to one verdict, and the probe writes what the table shows
+    let probe = r#"<!DOCTYPE html><html><body style="margin:0">
+<iframe src="index.html" style="width:390px;height:900px;border:0" onload="
+var d = this.contentDocument, e = d.documentElement, b = document.body;
+b.setAttribute('data-scroll-width', e.scrollWidth);
+b.setAttribute('data-client-width', e.clientWidth);
+d.querySelectorAll('thead th button')[1].click();
+var rows = d.getElementById('fleet').tBodies[0].rows;
+b.setAttribute('data-first', rows[0].dataset.verdict + ':' + rows[0].cells[1].dataset.key);
+var f = d.getElementById('verdict-filter');
+f.value = 'no_stiction';
+f.dispatchEvent(new Event('change'));
+var shown = 0;
+for (var i = 0; i < rows.length; i++) { if (!rows[i].hidden) shown++; }
+b.setAttribute('data-shown', shown);
+"></iframe></body></html>"#;
     let probe_path = out.join("probe.html");
     std::fs::write(&probe_path, probe).unwrap();
     let url = format!("file://{}", s(&probe_path));

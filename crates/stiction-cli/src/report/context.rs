@@ -6,7 +6,7 @@ use super::plots::{self, Figure, PHASE_SIZE, TREND_SIZE};
 use super::sections::{self, Estimates, Evidence, KvRow, Notes, Quality, Windows};
 use super::series::{self, LONG_RECORD};
 use super::PageOptions;
-use crate::cmd_diagnose::{Columns, LoopFile};
+use crate::loop_file::{Columns, LoopFile};
 use crate::words::{capital, duration, num, verdict};
 use anyhow::Result;
 use serde::Serialize;

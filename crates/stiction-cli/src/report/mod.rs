@@ -18,7 +18,7 @@ mod series;
 pub use context::Link;
 
 use crate::atomic::write_atomic;
-use crate::cmd_diagnose::{Columns, LoopFile};
+use crate::loop_file::{Columns, LoopFile};
 use anyhow::{Context as _, Result};
 use minijinja::{AutoEscape, Environment, Value};
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! min/max decimation for long traces, thinning for the phase plot, and the zoom window of a long
 //! record (the stretch where OP and PV vary most).
 
-use crate::cmd_diagnose::LoopFile;
+use crate::loop_file::LoopFile;
 
 /// A record longer than this many samples gets an overview (decimated) and a zoomed window.
 pub const LONG_RECORD: usize = 5000;
