@@ -198,6 +198,22 @@ fn the_fleet_page_sorts_filters_and_shows_sparklines() {
     assert!(main < back && back < header);
     assert_eq!(report.matches("class=\"back\"").count(), 1);
     assert!(!report.contains("<script"), "a report has no script");
+    // --resume keeps every loop and still shows its sparkline (the loop is read again)
+    let plant = dir.path().join("plant");
+    let again = ok(&[
+        "batch",
+        s(&plant),
+        "-o",
+        s(&out),
+        "--sp",
+        "sp",
+        "--no-quantify",
+        "--reports",
+        "--resume",
+    ]);
+    assert!(again.contains("3 kept"), "{again}");
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert_eq!(index.matches("<svg class=\"spark\"").count(), 3);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -274,6 +274,8 @@ fn draw<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(c.x_label.as_str())
         .y_desc(c.y_label.as_str())
+        // about one label per 90 pixels: four-digit times do not touch on a narrow chart
+        .x_labels((plot.dim_in_pixel().0 as usize / 90).clamp(3, 10))
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
         .label_style(("sans-serif", 15))

@@ -6,9 +6,10 @@ use crate::plot::{self, Chart, Kind, Series};
 use anyhow::Result;
 use serde::Serialize;
 
-/// Chart sizes in SVG user units; the page scales them to its width.
-pub const TREND_SIZE: [(u32, u32); 2] = [(960, 360), (520, 380)];
-pub const PHASE_SIZE: [(u32, u32); 2] = [(960, 600), (520, 480)];
+/// Chart sizes in SVG user units; the page scales them to its width (a phone's 360 px or so
+/// shows the narrow ones at about 0.85, so their 15-unit labels stay readable).
+pub const TREND_SIZE: [(u32, u32); 2] = [(960, 360), (440, 340)];
+pub const PHASE_SIZE: [(u32, u32); 2] = [(960, 600), (440, 420)];
 
 /// One figure of the page: the chart for wide and for narrow screens, inline SVG markup.
 #[derive(Serialize)]
