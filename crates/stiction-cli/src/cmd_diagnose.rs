@@ -105,14 +105,6 @@ pub fn print_notes(name: &str, lf: &LoopFile, stderr: bool) {
     }
 }
 
-fn vote_word(v: Vote) -> &'static str {
-    match v {
-        Vote::Stiction => "stiction",
-        Vote::NoStiction => "no stiction",
-        Vote::Undetermined => "undetermined",
-    }
-}
-
 fn band_source(s: BandSource) -> &'static str {
     match s {
         BandSource::Valve => "from the recorded valve position",
@@ -190,7 +182,7 @@ pub fn print_human(file: &str, d: &Diagnosis) {
         println!(
             "    {:<21} {:<13} {}",
             f.family.words(),
-            vote_word(f.vote),
+            crate::words::vote(f.vote),
             f.note
         );
     }
@@ -201,7 +193,7 @@ pub fn print_human(file: &str, d: &Diagnosis) {
                 "    {:<18} {:>8}  {:<13} {}{}",
                 i.name,
                 i.value.map_or("-".into(), |v| format!("{v:.3}")),
-                vote_word(i.vote),
+                crate::words::vote(i.vote),
                 i.threshold,
                 if i.weight == 0.0 {
                     " [shown, not counted]"

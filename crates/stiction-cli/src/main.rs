@@ -14,6 +14,7 @@ mod data;
 mod exit;
 mod loop_file;
 mod plot;
+mod report;
 mod spec;
 mod words;
 

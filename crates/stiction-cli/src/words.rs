@@ -1,5 +1,9 @@
 //! Small pieces of the CLI's own wording: counts with the right plural, seconds rounded for a
-//! person to read.
+//! person to read, numbers as the report prints them, and each verdict, outcome and vote named
+//! once for the terminal, the loop report and the fleet page.
+
+use stiction_core::diagnose::{Verdict, Vote};
+use stiction_core::fleet::Outcome;
 
 /// `1 gap`, `2 gaps`: the count and the noun in the right number.
 pub fn count(n: impl std::fmt::Display, one: &str, many: &str) -> String {
@@ -26,9 +30,122 @@ pub fn seconds(s: f64) -> String {
     }
 }
 
+/// A verdict in words: "no stiction", "insufficient data".
+pub fn verdict(v: Verdict) -> &'static str {
+    match v {
+        Verdict::Stiction => "stiction",
+        Verdict::NoStiction => "no stiction",
+        Verdict::Undetermined => "undetermined",
+        Verdict::InsufficientData => "insufficient data",
+    }
+}
+
+/// A fleet outcome in words: a verdict's words, or "failed".
+pub fn outcome(o: Outcome) -> &'static str {
+    match o {
+        Outcome::Stiction => verdict(Verdict::Stiction),
+        Outcome::NoStiction => verdict(Verdict::NoStiction),
+        Outcome::Undetermined => verdict(Verdict::Undetermined),
+        Outcome::InsufficientData => verdict(Verdict::InsufficientData),
+        Outcome::Failed => "failed",
+    }
+}
+
+/// A vote in words.
+pub fn vote(v: Vote) -> &'static str {
+    match v {
+        Vote::Stiction => "stiction",
+        Vote::NoStiction => "no stiction",
+        Vote::Undetermined => "undetermined",
+    }
+}
+
+/// A vote's name in files and CSS classes (`no_stiction`).
+pub fn vote_code(v: Vote) -> &'static str {
+    match v {
+        Vote::Stiction => "stiction",
+        Vote::NoStiction => "no_stiction",
+        Vote::Undetermined => "undetermined",
+    }
+}
+
+/// The text with its first letter in upper case.
+pub fn capital(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
+}
+
+/// A number with about four significant digits as the pages print it: no trailing zeros, a true
+/// minus sign, never "−0"; ∞ and – for the non-finite.
+pub fn num(v: f64) -> String {
+    if v.is_nan() {
+        return "–".into();
+    }
+    if v.is_infinite() {
+        return if v > 0.0 {
+            "∞".into()
+        } else {
+            "−∞".into()
+        };
+    }
+    let a = v.abs();
+    let s = if a == 0.0 {
+        "0".to_string()
+    } else if !(1e-3..1e6).contains(&a) {
+        format!("{v:.3e}")
+    } else if a >= 1000.0 {
+        format!("{v:.0}")
+    } else if a >= 100.0 {
+        format!("{v:.1}")
+    } else if a >= 10.0 {
+        format!("{v:.2}")
+    } else if a >= 1.0 {
+        format!("{v:.3}")
+    } else {
+        format!("{v:.4}")
+    };
+    // 12.00 → 12, 0.0500 → 0.05 (not in the exponent form)
+    let s = if s.contains('.') && !s.contains('e') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
+    s.replace('-', "−")
+}
+
+/// [`num`], or – for none.
+pub fn opt(v: Option<f64>) -> String {
+    v.map_or("–".into(), num)
+}
+
+/// A duration: seconds, with minutes or hours beside them when they read better.
+pub fn duration(v: f64) -> String {
+    if v >= 7200.0 {
+        format!("{} s ({} h)", num(v), num(v / 3600.0))
+    } else if v >= 120.0 {
+        format!("{} s ({} min)", num(v), num(v / 60.0))
+    } else {
+        format!("{} s", num(v))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_as_the_pages_print_them() {
+        assert_eq!(num(12.0), "12");
+        assert_eq!(num(0.05), "0.05");
+        assert_eq!(num(-0.0), "0");
+        assert_eq!(num(-1.5), "−1.5");
+        assert_eq!(num(f64::NAN), "–");
+        assert_eq!(duration(7200.0), "7200 s (2 h)");
+        assert_eq!(capital("no stiction"), "No stiction");
+        assert_eq!(outcome(Outcome::InsufficientData), "insufficient data");
+    }
 
     #[test]
     fn plurals_and_rounded_seconds() {

@@ -14,6 +14,8 @@ use super::summary::{self, Fate, Row, SourceStatus};
 use crate::atomic::write_atomic;
 use crate::cmd_diagnose::{Columns, LoopFile};
 use crate::data::Table;
+use crate::report::fleet::Spark;
+use crate::report::{self, PageOptions};
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -215,12 +217,12 @@ fn read_loop(loaded: Loaded, columns: &Columns) -> Result<LoopFile, String> {
 }
 
 /// The loop's full report (`stiction report`), with a link back to the fleet's index page.
-fn render_report(loop_id: &str, lf: &LoopFile, d: &Diagnosis) -> Result<String> {
-    Ok(crate::cmd_report::render(loop_id, lf, d)?.replacen(
-        "<main>\n",
-        "<main>\n<p class=\"back\"><a href=\"../index.html\">&larr; all loops</a></p>\n",
-        1,
-    ))
+fn render_report(loop_id: &str, lf: &LoopFile, d: &Diagnosis, columns: &Columns) -> Result<String> {
+    let options = PageOptions {
+        columns: Some(columns),
+        back_link: Some(("../index.html".into(), "all loops".into())),
+    };
+    report::loop_page(loop_id, lf, d, &options)
 }
 
 /// Diagnose one loop: never panics, never fails the batch; a loop that cannot be read or
@@ -257,6 +259,12 @@ fn process(job: Job, ctx: &Ctx) -> Option<Row> {
                 let row = fleet::Row::from_diagnosis(&id, &source, &old.diagnosis);
                 let mut row = Row::new(row, Fate::Kept);
                 row.report = report_path.is_some();
+                // the index shows the loop's sparkline: read the loop again (no diagnosis)
+                if row.report {
+                    row.spark = read_loop(loaded, &columns)
+                        .ok()
+                        .map(|lf| Spark::of(&lf.pv, &lf.op));
+                }
                 return Some(row);
             }
             Fate::Redone
@@ -273,6 +281,9 @@ fn process(job: Job, ctx: &Ctx) -> Option<Row> {
         Err(e) => return Some(Row::failed(&id, &source, format!("{source}: {e}"))),
     };
     let mut row = Row::new(fleet::Row::from_diagnosis(&id, &source, &d), fate);
+    if report_path.is_some() {
+        row.spark = Some(Spark::of(&lf.pv, &lf.op));
+    }
     let saved = serde_json::to_vec_pretty(&LoopJsonRef {
         input: &input,
         diagnosis: &d,
@@ -288,7 +299,7 @@ fn process(job: Job, ctx: &Ctx) -> Option<Row> {
         ));
     }
     if let Some(path) = report_path {
-        match render_report(&id, &lf, &d) {
+        match render_report(&id, &lf, &d, &columns) {
             Ok(html) => match write_atomic(&path, html.as_bytes()) {
                 Ok(()) => row.report = true,
                 Err(e) => {

@@ -2,6 +2,7 @@
 //! core's [`fleet::ranking`]), written to summary.csv and summary.json.
 
 use crate::atomic::write_with;
+use crate::report::fleet::Spark;
 use anyhow::Result;
 use serde::Serialize;
 use std::borrow::Cow;
@@ -49,6 +50,9 @@ pub struct Row {
     /// Has an HTML report.
     #[serde(skip)]
     pub report: bool,
+    /// PV and OP for the fleet page's sparkline (at most 200 bytes), when the index is written.
+    #[serde(skip)]
+    pub spark: Option<Spark>,
 }
 
 impl Row {
@@ -58,6 +62,7 @@ impl Row {
             source_status: SourceStatus::Present,
             fate,
             report: false,
+            spark: None,
         }
     }
 

@@ -1,13 +1,23 @@
 //! Charts as PNG and SVG. Plotting takes finished result data; it never computes.
+//!
+//! Every chart has its title on top, its legend in a strip between the title and the data (never
+//! over the data), and tick labels without trailing zeros or a negative zero. PNG text goes
+//! through [`glyphs::GlyphText`], which spaces the glyphs right.
+
+mod glyphs;
+mod ticks;
+
+pub use ticks::tick_label;
 
 use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
 /// DejaVu Sans, embedded so charts need no system fonts (licence in assets/).
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
 fn register_font() {
@@ -85,7 +95,9 @@ pub fn save_panels(charts: &[Chart], stem: &Path) -> Result<Vec<PathBuf>> {
     let size = (1000, 600 * charts.len().max(1) as u32);
     // the PNG encoder writes to a path: it gets the atomic write's temporary file
     crate::atomic::write_via(&png, |tmp| {
-        let bitmap = BitMapBackend::new(tmp, size).into_drawing_area();
+        let backend = glyphs::GlyphText::new(BitMapBackend::new(tmp, size), FONT)
+            .ok_or_else(|| anyhow!("the embedded font cannot be read"))?;
+        let bitmap = backend.into_drawing_area();
         for (area, chart) in bitmap
             .split_evenly((charts.len(), 1))
             .into_iter()
@@ -158,15 +170,103 @@ fn bounds(chart: &Chart) -> ((f64, f64), (f64, f64)) {
     (xr, pad(yr, 0.08))
 }
 
+/// What a legend entry shows beside its label.
+#[derive(Clone, Copy)]
+enum Swatch {
+    Line(RGBColor),
+    Band(RGBColor),
+}
+
+/// The legend's entries in drawing order: bands, then each labelled series once.
+fn legend_entries(c: &Chart) -> Vec<(String, Swatch)> {
+    let mut out: Vec<(String, Swatch)> = c
+        .bands
+        .iter()
+        .filter(|b| !b.label.is_empty())
+        .map(|b| (b.label.clone(), Swatch::Band(color(b.color))))
+        .collect();
+    for s in &c.series {
+        if !s.label.is_empty() && !out.iter().any(|(l, _)| *l == s.label) {
+            out.push((s.label.clone(), Swatch::Line(color(s.color))));
+        }
+    }
+    out
+}
+
+const LEGEND_FONT: u32 = 15;
+const LEGEND_ROW: i32 = 22;
+const SWATCH: i32 = 22;
+
+/// Place the entries in rows from `left`, wrapping at `width`: each entry's top-left corner.
+fn legend_places<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(String, Swatch)],
+    left: i32,
+) -> Vec<(i32, i32)> {
+    let width = area.dim_in_pixel().0 as i32;
+    let font: TextStyle = ("sans-serif", LEGEND_FONT).into_font().into();
+    let (mut x, mut y) = (left, 0);
+    let mut places = Vec::with_capacity(entries.len());
+    for (label, _) in entries {
+        let text = area
+            .estimate_text_size(label, &font)
+            .map_or(8 * label.len() as i32, |(w, _)| w as i32);
+        let need = SWATCH + 6 + text + 22;
+        if x > left && x + need > width {
+            (x, y) = (left, y + LEGEND_ROW);
+        }
+        places.push((x, y));
+        x += need;
+    }
+    places
+}
+
+/// The legend strip above the data: a swatch and a label per entry.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(String, Swatch)],
+    places: &[(i32, i32)],
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let font = ("sans-serif", LEGEND_FONT)
+        .into_font()
+        .color(&RGBColor(40, 40, 40))
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    for ((label, swatch), &(x, y)) in entries.iter().zip(places) {
+        let mid = y + LEGEND_ROW / 2;
+        match *swatch {
+            Swatch::Line(c) => area.draw(&PathElement::new(
+                vec![(x, mid), (x + SWATCH, mid)],
+                c.stroke_width(3),
+            ))?,
+            Swatch::Band(c) => area.draw(&Rectangle::new(
+                [(x, mid - 5), (x + SWATCH, mid + 5)],
+                c.mix(0.4).filled(),
+            ))?,
+        }
+        area.draw_text(label, &font, (x + SWATCH + 6, mid))?;
+    }
+    Ok(())
+}
+
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     c: &Chart,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     root.fill(&WHITE)?;
     let ((x0, x1), (y0, y1)) = bounds(c);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(&c.title, ("sans-serif", 24))
+    let root_titled = root.titled(&c.title, ("sans-serif", 24))?;
+    let entries = legend_entries(c);
+    // the legend starts where the plotting area does (margin + y label area)
+    let places = legend_places(&root_titled, &entries, 16 + 70);
+    let rows = places.last().map_or(0, |p| p.1 / LEGEND_ROW + 1);
+    let (legend, plot) = root_titled.split_vertically(rows * LEGEND_ROW + 4);
+    draw_legend(&legend, &entries, &places)?;
+    let (x_step, y_step) = (ticks::step(x0, x1), ticks::step(y0, y1));
+    let x_fmt = move |v: &f64| tick_label(*v, x_step);
+    let y_fmt = move |v: &f64| tick_label(*v, y_step);
+    let mut chart = ChartBuilder::on(&plot)
         .margin(16)
+        .margin_top(6)
         .x_label_area_size(50)
         .y_label_area_size(70)
         .build_cartesian_2d(x0..x1, y0..y1)?;
@@ -174,6 +274,10 @@ fn draw<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(c.x_label.as_str())
         .y_desc(c.y_label.as_str())
+        // about one label per 90 pixels: four-digit times do not touch on a narrow chart
+        .x_labels((plot.dim_in_pixel().0 as usize / 90).clamp(3, 10))
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
         .light_line_style(RGBColor(235, 235, 235))
@@ -190,14 +294,8 @@ fn draw<DB: DrawingBackend>(
         } else {
             Rectangle::new([(x0, b.lo), (x1, b.lo)], style)
         };
-        chart
-            .draw_series(std::iter::once(rect))?
-            .label(b.label.as_str())
-            .legend(move |(x, y)| {
-                Rectangle::new([(x, y - 5), (x + 20, y + 5)], col.mix(0.4).filled())
-            });
+        chart.draw_series(std::iter::once(rect))?;
     }
-    let mut labelled = std::collections::HashSet::new();
     for s in &c.series {
         let col = color(s.color);
         // a 2-pixel line looks ragged on dense series in the bitmap backend
@@ -208,7 +306,7 @@ fn draw<DB: DrawingBackend>(
             col.stroke_width(width)
         };
         let pts: Vec<(f64, f64)> = s.x.iter().copied().zip(s.y.iter().copied()).collect();
-        let anno = match s.kind {
+        match s.kind {
             Kind::Line => chart.draw_series(LineSeries::new(pts, style))?,
             Kind::Step => {
                 let mut stairs = Vec::with_capacity(pts.len() * 2);
@@ -221,19 +319,7 @@ fn draw<DB: DrawingBackend>(
                 chart.draw_series(LineSeries::new(stairs, style))?
             }
         };
-        if !s.label.is_empty() && labelled.insert(s.label.clone()) {
-            anno.label(s.label.as_str()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(3))
-            });
-        }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 15))
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(160, 160, 160))
-        .draw()?;
     root.present()?;
     Ok(())
 }

@@ -1,0 +1,432 @@
+//! The loop report's context: every value the template shows, built from the loop's data and
+//! its diagnosis as plain serialisable structs (text, numbers already in words, figures as SVG).
+//! The template lays it out and escapes every text; nothing here writes HTML but the charts.
+
+use super::plots::{self, Figure, PHASE_SIZE, TREND_SIZE};
+use super::sections::{self, Estimates, Evidence, KvRow, Notes, Quality, Windows};
+use super::series::{self, LONG_RECORD};
+use super::PageOptions;
+use crate::loop_file::{Columns, LoopFile};
+use crate::words::{capital, duration, num, verdict};
+use anyhow::Result;
+use serde::Serialize;
+use stiction_core::diagnose::Diagnosis;
+use stiction_core::quantify::Quantification;
+
+/// Text with a little markup: plain runs, `code` runs and `strong` runs.
+#[derive(Serialize, Default)]
+pub struct Rich(Vec<Piece>);
+
+#[derive(Serialize)]
+struct Piece {
+    kind: &'static str,
+    text: String,
+}
+
+impl Rich {
+    fn push(mut self, kind: &'static str, text: impl Into<String>) -> Rich {
+        self.0.push(Piece {
+            kind,
+            text: text.into(),
+        });
+        self
+    }
+    pub fn text(self, t: impl Into<String>) -> Rich {
+        self.push("text", t)
+    }
+    pub fn code(self, t: impl Into<String>) -> Rich {
+        self.push("code", t)
+    }
+    pub fn strong(self, t: impl Into<String>) -> Rich {
+        self.push("strong", t)
+    }
+}
+
+/// Plain text as [`Rich`].
+pub fn rich(t: impl Into<String>) -> Rich {
+    Rich::default().text(t)
+}
+
+/// Trends: the record (an overview when it is long), the figures and a note on the stretch.
+#[derive(Serialize)]
+pub struct Trends {
+    pub overview: bool,
+    pub figures: Vec<Figure>,
+    pub note: Option<String>,
+}
+
+/// The zoomed window of a long record.
+#[derive(Serialize)]
+pub struct Zoom {
+    pub heading: String,
+    pub how: String,
+    pub figures: Vec<Figure>,
+}
+
+#[derive(Serialize)]
+pub struct VerdictBox {
+    pub code: &'static str,
+    pub word: String,
+    pub confidence: Option<String>,
+    pub bar_percent: Option<f64>,
+    pub reason: Option<String>,
+    pub evidence: Vec<String>,
+    pub band: Option<BandLine>,
+    pub next_step: String,
+}
+
+#[derive(Serialize)]
+pub struct BandLine {
+    pub percent: String,
+    pub set: Option<String>,
+    pub source: &'static str,
+}
+
+#[derive(Serialize)]
+pub struct Link {
+    pub href: String,
+    pub text: String,
+}
+
+/// Everything the report template shows.
+#[derive(Serialize)]
+pub struct Report {
+    pub version: &'static str,
+    pub title: String,
+    pub loop_id: String,
+    pub verdict_words: &'static str,
+    pub back: Option<Link>,
+    pub meta: String,
+    pub columns: Vec<Rich>,
+    pub toc: Vec<Link>,
+    pub verdict: VerdictBox,
+    pub trends: Trends,
+    pub zoom: Option<Zoom>,
+    pub phase: Figure,
+    pub evidence: Evidence,
+    pub oscillation: Option<Vec<KvRow>>,
+    pub estimates: Estimates,
+    pub convergence: Option<sections::Convergence>,
+    pub quality: Quality,
+    pub windows: Option<Windows>,
+    pub notes: Notes,
+    pub seconds: String,
+}
+
+/// Trends keep the first, lowest and highest sample of this many buckets (spikes and envelope
+/// survive); a long record's overview fewer; the phase plot keeps every k-th sample up to this
+/// many points.
+const TREND_BUCKETS: usize = 1500;
+const OVERVIEW_BUCKETS: usize = 600;
+const PHASE_POINTS: usize = 6000;
+/// Buckets enough to keep every sample of a zoom window (at most 2000).
+const EVERY_SAMPLE: usize = 1 << 20;
+
+pub fn build(loop_id: &str, lf: &LoopFile, d: &Diagnosis, o: &PageOptions) -> Result<Report> {
+    let q = d.quantification.as_ref().filter(|q| q.status == "ok");
+    let zoom = if lf.op.len() > LONG_RECORD {
+        Some(zoom(lf, d, q)?)
+    } else {
+        None
+    };
+    Ok(Report {
+        version: env!("CARGO_PKG_VERSION"),
+        title: format!("{loop_id}: {}", verdict(d.verdict)),
+        loop_id: loop_id.to_string(),
+        verdict_words: verdict(d.verdict),
+        back: o.back_link.as_ref().map(|(href, text)| Link {
+            href: href.clone(),
+            text: text.clone(),
+        }),
+        meta: meta(lf, d),
+        columns: o.columns.map(|c| columns(c, lf)).unwrap_or_default(),
+        toc: toc(d, zoom.is_some()),
+        verdict: verdict_box(d),
+        trends: trends(lf, d, q)?,
+        zoom,
+        phase: phase(lf, d, q)?,
+        evidence: sections::evidence(d),
+        oscillation: sections::oscillation(d),
+        estimates: sections::estimates(d, q),
+        convergence: q.map(sections::convergence),
+        quality: sections::quality(d),
+        windows: sections::windows(d),
+        notes: sections::notes(d, q),
+        seconds: num(d.seconds),
+    })
+}
+
+fn meta(lf: &LoopFile, d: &Diagnosis) -> String {
+    let [s, e] = d.analysed;
+    format!(
+        "{} samples at {} s, {} in all; analysed samples {s} to {e}{}{}.",
+        d.samples,
+        num(d.ts),
+        duration(d.samples as f64 * d.ts),
+        if lf.auto.is_some() {
+            ", in automatic"
+        } else {
+            ""
+        },
+        if lf.sp.is_some() {
+            " with a constant setpoint"
+        } else {
+            ""
+        },
+    )
+}
+
+fn columns(c: &Columns, lf: &LoopFile) -> Vec<Rich> {
+    let mut parts = vec![rich("OP ").code(&c.op), rich("PV ").code(&c.pv)];
+    if let Some(sp) = &c.sp {
+        parts.push(rich("SP ").code(sp));
+    }
+    if let Some(m) = &c.mode {
+        parts.push(rich("mode ").code(m));
+    }
+    match (&c.time, &lf.time) {
+        (Some(t), _) => parts.push(rich("time ").code(t)),
+        (None, Some(_)) => parts.push(rich("time column found by its name")),
+        (None, None) => {}
+    }
+    if c.integrating {
+        parts.push(rich("integrating process"));
+    }
+    parts
+}
+
+fn toc(d: &Diagnosis, zoom: bool) -> Vec<Link> {
+    let mut links = vec![("trends", "Trends")];
+    if zoom {
+        links.push(("zoom", "Zoom"));
+    }
+    links.extend([
+        ("phase", "PV against OP"),
+        ("indices", "Indices"),
+        ("oscillation", "Oscillation"),
+        ("estimates", "Estimates"),
+        ("convergence", "Convergence"),
+        ("quality", "Data quality"),
+    ]);
+    if !d.windows.is_empty() {
+        links.push(("windows", "Windows"));
+    }
+    links.push(("notes", "Notes"));
+    links
+        .into_iter()
+        .map(|(id, text)| Link {
+            href: format!("#{id}"),
+            text: text.into(),
+        })
+        .collect()
+}
+
+fn verdict_box(d: &Diagnosis) -> VerdictBox {
+    // for insufficient data and a loop without oscillation the evidence repeats the reason
+    let repeats_reason = matches!((d.evidence.as_slice(), &d.reason), ([e], Some(r)) if e == r);
+    VerdictBox {
+        code: d.verdict.as_str(),
+        word: capital(verdict(d.verdict)),
+        confidence: d.confidence.map(|c| format!("{c:.2}")),
+        bar_percent: d.confidence.map(|c| (c.clamp(0.0, 1.0) * 100.0).round()),
+        reason: d.reason.clone(),
+        evidence: if repeats_reason {
+            vec![]
+        } else {
+            d.evidence.clone()
+        },
+        band: d.band.as_ref().map(|b| BandLine {
+            percent: num(b.band_percent_of_span),
+            set: b
+                .interval_percent_of_span
+                .map(|[lo, hi]| format!("optimal set {} to {} %", num(lo), num(hi))),
+            source: b.source.words(),
+        }),
+        next_step: d.next_step.clone(),
+    }
+}
+
+/// The PV chart (with SP and the simulated PV) and the OP chart (with the estimated valve) over
+/// the samples `[a, b)`, `buckets` decimation buckets each.
+fn trend_pair(
+    lf: &LoopFile,
+    d: &Diagnosis,
+    q: Option<&Quantification>,
+    [a, b]: [usize; 2],
+    buckets: usize,
+) -> Result<Vec<Figure>> {
+    if b <= a {
+        return Ok(vec![]);
+    }
+    let t = series::time_axis(lf);
+    let (unit, per) = series::time_unit(t[b - 1] - t[a]);
+    let x_label = format!("time ({unit})");
+    let tu: Vec<f64> = t[a..b].iter().map(|v| v / per).collect();
+    // the fitted model and the estimated valve cover the samples the estimate used
+    let [s, e] = d.quantified.unwrap_or(d.analysed);
+    let (s2, e2) = (s.max(a), e.min(b));
+    let model = |v: &[f64]| {
+        (s < e && e <= t.len() && v.len() == e - s && s2 < e2)
+            .then(|| series::decimate(&tu[s2 - a..e2 - a], &v[s2 - s..e2 - s], buckets))
+    };
+    let pv = series::decimate(&tu, &lf.pv[a..b], buckets);
+    let sp = lf
+        .sp
+        .as_ref()
+        .map(|sp| series::decimate(&tu, &sp[a..b], buckets));
+    let sim = q.and_then(|q| model(&q.pv_simulated));
+    let mv = q.and_then(|q| model(&q.mv));
+    let mut traces = vec![plots::line("PV", &pv, 0)];
+    if let Some(sp) = &sp {
+        traces.push(plots::line("SP", sp, 2));
+    }
+    if let Some(sim) = &sim {
+        traces.push(plots::line("PV simulated", sim, 1));
+    }
+    let mut caption = String::from("Process variable");
+    if sp.is_some() {
+        caption.push_str(" and setpoint");
+    }
+    if sim.is_some() {
+        caption.push_str(
+            "; in red the PV the fitted valve-and-process model simulates from OP alone, over the samples the estimate used",
+        );
+    }
+    caption.push('.');
+    let pv_fig = plots::figure(
+        &plots::chart("Process variable", &x_label, "PV", traces),
+        TREND_SIZE,
+        caption,
+    )?;
+    let op = series::decimate(&tu, &lf.op[a..b], buckets);
+    let mut traces = vec![plots::line("OP", &op, 0)];
+    if let Some(mv) = &mv {
+        traces.push(plots::steps("estimated MV", mv, 1));
+    }
+    let caption = if mv.is_some() {
+        "Controller output and, in red, the valve position the fitted stiction model estimates \
+         (the valve is not measured: it holds until OP has moved more than the band away from it)."
+    } else {
+        "Controller output."
+    };
+    let op_fig = plots::figure(
+        &plots::chart("Controller output", &x_label, "OP", traces),
+        TREND_SIZE,
+        caption.into(),
+    )?;
+    Ok(vec![pv_fig, op_fig])
+}
+
+fn trends(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Trends> {
+    let n = lf.op.len();
+    let overview = n > LONG_RECORD;
+    let buckets = if overview {
+        OVERVIEW_BUCKETS
+    } else {
+        TREND_BUCKETS
+    };
+    let mut figures = trend_pair(lf, d, q, [0, n], buckets)?;
+    if overview {
+        for f in &mut figures {
+            f.caption = format!(
+                "Overview of all {n} samples: the lowest and highest sample of each of {buckets} \
+                 stretches, so spikes stay visible. {}",
+                f.caption
+            );
+        }
+    }
+    let [s, e] = d.quantified.unwrap_or(d.analysed);
+    let t = series::time_axis(lf);
+    let note = (s > 0 || e < d.samples).then(|| {
+        format!(
+            "The diagnosis uses samples {s} to {e} (t = {} to {} s); the rest of the record is in \
+             manual, or has another setpoint.",
+            num(t.get(s).copied().unwrap_or(0.0)),
+            num(t.get(e.saturating_sub(1)).copied().unwrap_or(0.0))
+        )
+    });
+    Ok(Trends {
+        overview,
+        figures,
+        note,
+    })
+}
+
+/// The window of a long record where OP and PV vary most, inside the analysed stretch, at full
+/// resolution.
+fn zoom(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Zoom> {
+    let n = lf.op.len();
+    let [s, e] = d.analysed;
+    let (s, e) = if s < e && e <= n { (s, e) } else { (0, n) };
+    let period = d
+        .oscillation
+        .as_ref()
+        .and_then(|o| o.period)
+        .map(|p| p / d.ts);
+    let len = series::zoom_length(period, e - s);
+    let a = s + series::busiest_window(&lf.op[s..e], &lf.pv[s..e], len);
+    let b = a + len;
+    let t = series::time_axis(lf);
+    let figures = trend_pair(lf, d, q, [a, b], EVERY_SAMPLE)?;
+    let why = match period {
+        Some(p) if 5.0 * p >= 300.0 && 5.0 * p <= 2000.0 => "five periods of the oscillation",
+        Some(_) => "about five periods of the oscillation, kept between 300 and 2000 samples",
+        None => "no oscillation period to size it by",
+    };
+    Ok(Zoom {
+        heading: format!(
+            "Zoom: samples {a} to {b} (t = {} to {})",
+            duration(t[a]),
+            duration(t[b - 1])
+        ),
+        how: format!(
+            "Every sample of the {len}-sample window ({why}) in which OP and PV vary most: of all \
+             windows of that length inside the analysed stretch (samples {s} to {e}), the one with \
+             the largest sum of the variances of OP and PV in the window, each relative to its \
+             variance over the stretch. Noise weighs alike in every window, so this is where the \
+             oscillation, or the stick-slip episodes, are largest."
+        ),
+        figures,
+    })
+}
+
+fn phase(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Figure> {
+    let [s, e] = d.quantified.unwrap_or(d.analysed);
+    let (s, e) = if s + 1 < e && e <= lf.op.len() {
+        (s, e)
+    } else {
+        (0, lf.op.len())
+    };
+    let op = series::thin(&lf.op[s..e], PHASE_POINTS);
+    let measured = (op.clone(), series::thin(&lf.pv[s..e], PHASE_POINTS));
+    let sim = q
+        .filter(|q| q.pv_simulated.len() == e - s)
+        .map(|q| (op.clone(), series::thin(&q.pv_simulated, PHASE_POINTS)));
+    let mut traces = vec![plots::line("measured", &measured, 5)];
+    if let Some(sim) = &sim {
+        traces.push(plots::line("fitted model, simulated", sim, 1));
+    }
+    let title = match q.and_then(|q| q.apparent_stiction.map(|b| (q, b))) {
+        Some((q, b)) if sim.is_some() => format!(
+            "PV against OP, with the fitted {} model (d = {})",
+            capital(&q.model.to_string()),
+            num(b)
+        ),
+        _ => "PV against OP".into(),
+    };
+    let chart = plots::chart(
+        &title,
+        "controller output OP",
+        "process variable PV",
+        traces,
+    );
+    let caption = if sim.is_some() {
+        "The measured PV against OP (grey) over the analysed stretch, and the PV the fitted model \
+         simulates (red). While a sticky valve holds, OP moves and PV does not follow: the plot draws \
+         a loop rather than a line."
+    } else {
+        "The measured PV against OP over the analysed stretch. While a sticky valve holds, OP moves \
+         and PV does not follow: the plot draws a loop rather than a line. No model was fitted."
+    };
+    plots::figure(&chart, PHASE_SIZE, caption.into())
+}
