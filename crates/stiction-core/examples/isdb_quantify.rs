@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use stiction_core::estimate::Method;
 use stiction_core::models::ModelKind;
-use stiction_core::quantify::{quantify, QuantifyRequest};
+use stiction_core::quantify::{quantify, QuantifyRequest, QuantifyStatus};
 
 #[path = "common/isdb.rs"]
 mod isdb;
@@ -80,7 +80,7 @@ fn main() {
         let t = Instant::now();
         let qe = quantify(&op, &pv, &req).expect("valid request");
         let secs_e = t.elapsed().as_secs_f64();
-        let estimated = if qe.status == "ok" {
+        let estimated = if qe.status == QuantifyStatus::Ok {
             format!(
                 "{:.1}, {:.3}, {secs_e:.2}",
                 qe.apparent_stiction_pct_of_op_range.unwrap_or(f64::NAN),
@@ -89,7 +89,7 @@ fn main() {
         } else {
             "insufficient data".into()
         };
-        let row = if q.status == "ok" {
+        let row = if q.status == QuantifyStatus::Ok {
             let lm = q.linear_model.as_ref().expect("ok has a model");
             let [a, b] = q.interval["d"];
             format!(
@@ -99,7 +99,7 @@ fn main() {
                 q.samples,
                 q.params["d"],
                 q.apparent_stiction_pct_of_op_range.unwrap_or(f64::NAN),
-                lm.family.replace('_', "-"),
+                lm.family,
                 lm.na,
                 lm.nb,
                 lm.nk,

@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 use std::time::Instant;
 use stiction_core::estimate::Method;
 use stiction_core::models::{Kano, Model, ModelKind, Stenman};
-use stiction_core::quantify::{quantify, QuantifyRequest};
+use stiction_core::quantify::{quantify, LinearFamily, QuantifyRequest};
 use stiction_core::rng::seeded;
 use stiction_core::sim::{ClosedLoop, Pi, Process, Signal};
 
@@ -134,7 +134,11 @@ fn run_case(valve: Model, plant: &Plant, nsr: f64, seed: u64) -> Row {
         .map(|l| {
             format!(
                 "{}{}{}/{}",
-                if l.family == "integrating" { "I" } else { "" },
+                if l.family == LinearFamily::Integrating {
+                    "I"
+                } else {
+                    ""
+                },
                 l.na,
                 l.nb,
                 l.nk

@@ -2,6 +2,35 @@
 //!
 //! Pure numerics: functions take slices and return serde-serialisable results; nothing here reads
 //! files, prints or plots. The command-line tool and every other front end share these results.
+//!
+//! A sticky valve in a simulated PI loop, diagnosed and its stiction band sized:
+//!
+//! ```
+//! use stiction_core::diagnose::{diagnose, DiagnoseRequest, LoopRecord, Verdict};
+//! use stiction_core::models::{Model, Stenman};
+//! use stiction_core::sim::ClosedLoop;
+//!
+//! // a Stenman valve with a band of 2 % of span in a first-order loop (the defaults)
+//! let mut sim = ClosedLoop::new(Model::Stenman(Stenman::new(2.0)?));
+//! sim.samples = 1500;
+//! sim.noise = 0.05;
+//! sim.seed = 3;
+//! let data = sim.run()?;
+//!
+//! let record = LoopRecord {
+//!     op: &data.op,
+//!     pv: &data.pv,
+//!     sp: Some(&data.sp),
+//!     mv: None,
+//!     time: None,
+//!     auto: None,
+//! };
+//! let d = diagnose(&record, &DiagnoseRequest::default())?;
+//! assert_eq!(d.verdict, Verdict::Stiction);
+//! let band = d.band.expect("a stiction verdict sizes the band");
+//! assert!((band.band_percent_of_span - 2.0).abs() < 0.5);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod detect;
 pub mod diagnose;

@@ -3,7 +3,7 @@
 use stiction_core::estimate::Method;
 use stiction_core::identify::{self, Data, SearchRange, Structure};
 use stiction_core::models::{Model, ModelKind, Stenman};
-use stiction_core::quantify::{quantify, QuantifyRequest};
+use stiction_core::quantify::{quantify, QuantifyRequest, QuantifyStatus, ValveStartKind};
 use stiction_core::sim::{ClosedLoop, Signal};
 
 fn sticky_loop(d: f64, noise: f64, seed: u64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
@@ -59,7 +59,7 @@ fn stenman_band_from_op_and_pv_alone() {
         &QuantifyRequest::new(ModelKind::Stenman, Method::Exact),
     )
     .unwrap();
-    assert_eq!(q.status, "ok");
+    assert_eq!(q.status, QuantifyStatus::Ok);
     let d = q.params["d"];
     assert!((d - 1.0).abs() < 0.05, "d = {d}");
     let [lo, hi] = q.interval["d"];
@@ -116,7 +116,7 @@ fn loops_that_cannot_be_judged_say_why() {
     let (op, _, pv) = sticky_loop(1.0, 0.05, 2);
     let req = QuantifyRequest::new(ModelKind::Stenman, Method::Exact);
     let short = quantify(&op[..60], &pv[..60], &req).unwrap();
-    assert_eq!(short.status, "insufficient_data");
+    assert_eq!(short.status, QuantifyStatus::InsufficientData);
     assert!(short.reason.unwrap().contains("samples"));
     let flat = quantify(&op, &vec![3.0; op.len()], &req).unwrap();
     assert!(flat.reason.unwrap().contains("PV is constant"));
@@ -159,9 +159,9 @@ fn a_record_that_starts_mid_cycle_needs_the_valve_start_estimated() {
     let mut req = QuantifyRequest::new(ModelKind::Stenman, Method::Exact);
     req.estimate_start = true;
     let estimated = quantify(op, pv, &req).unwrap();
-    assert_eq!(plain.valve_start_kind.as_deref(), Some("first_op"));
+    assert_eq!(plain.valve_start_kind, Some(ValveStartKind::FirstOp));
     assert_eq!(plain.valve_start, Some(op[0]));
-    assert_eq!(estimated.valve_start_kind.as_deref(), Some("estimated"));
+    assert_eq!(estimated.valve_start_kind, Some(ValveStartKind::Estimated));
     let d = estimated.params["d"];
     assert!((d - 1.0).abs() < 0.1, "estimated start: d = {d}");
     let sse = |q: &stiction_core::quantify::Quantification| q.fit.as_ref().unwrap().sse_simulation;

@@ -16,6 +16,68 @@ use crate::spectral;
 /// Estimates that differ by more than this factor get a warning.
 const DISAGREE: f64 = 2.0;
 
+/// The band's other estimates (OP units), from the families and the oscillation.
+struct Beside<'a> {
+    /// The recorded valve position's band, when the valve family voted stiction.
+    valve: Option<&'a super::evidence::ValveEvidence>,
+    /// The stick-slip episodes' median OP travel.
+    stick: Option<f64>,
+    /// The band whose describing function closes the loop's harmonic balance, when the loop
+    /// family voted stiction.
+    describing: Option<f64>,
+    /// The width of the PV-OP ellipse of an oscillation.
+    ellipse: Option<f64>,
+}
+
+impl<'a> Beside<'a> {
+    fn new(d: &'a Diagnosis, sub: &LoopRecord, offset: usize, osc: &Oscillation, ts: f64) -> Self {
+        let family = |f: Family| d.families.iter().find(|e| e.family == f);
+        let valve = family(Family::Valve)
+            .filter(|f| f.vote == super::Vote::Stiction)
+            .and_then(|f| f.valve.as_ref());
+        let stick = family(Family::StickSlip)
+            .and_then(|f| f.stick_slip.as_ref())
+            .and_then(|s| s.median_travel);
+        let describing = family(Family::Loop)
+            .filter(|f| f.vote == super::Vote::Stiction)
+            .and_then(|f| f.limit_cycle.as_ref())
+            .and_then(|l| l.describing.as_ref())
+            .map(|b| b.band);
+        let ellipse = (osc.oscillating)
+            .then_some(osc.period)
+            .flatten()
+            .and_then(|p| {
+                let [s, e] = osc.stretch;
+                let f0 = ts / p;
+                spectral::apparent_stiction_ellipse(
+                    &sub.op[s - offset..e - offset],
+                    &sub.pv[s - offset..e - offset],
+                    0.5 * f0,
+                    (1.5 * f0).min(0.5),
+                )
+            })
+            .map(|el| el.width_along_x);
+        Self {
+            valve,
+            stick,
+            describing,
+            ellipse,
+        }
+    }
+}
+
+/// A band of `op_units` from `source`, nothing beside it yet.
+fn band_of(op_units: f64, source: BandSource, req: &DiagnoseRequest) -> Band {
+    Band {
+        band_percent_of_span: req.percent_of_span(op_units),
+        op_units,
+        interval_percent_of_span: None,
+        source,
+        others: Vec::new(),
+        ellipse_percent_of_span: None,
+    }
+}
+
 /// Fill `d.band` (and the closed-loop estimate) for the analysed stretch `sub`, which starts at
 /// sample `offset` of the record.
 pub(super) fn size(
@@ -26,107 +88,31 @@ pub(super) fn size(
     fits: Option<&FitComparison>,
     req: &DiagnoseRequest,
 ) {
-    let pct = |v: f64| req.percent_of_span(v);
-    let family = |f: Family| d.families.iter().find(|e| e.family == f);
-    let valve = family(Family::Valve)
-        .and_then(|f| f.valve.as_ref())
-        .filter(|_| family(Family::Valve).is_some_and(|f| f.vote == super::Vote::Stiction));
-    let stick = family(Family::StickSlip)
-        .and_then(|f| f.stick_slip.as_ref())
-        .and_then(|s| s.median_travel);
-    // the band whose describing function closes the loop's harmonic balance, when the loop
-    // family voted stiction (OP units)
-    let describing = family(Family::Loop)
-        .filter(|f| f.vote == super::Vote::Stiction)
-        .and_then(|f| f.limit_cycle.as_ref())
-        .and_then(|l| l.describing.as_ref())
-        .map(|b| b.band);
-    let ellipse = (osc.oscillating)
-        .then_some(osc.period)
-        .flatten()
-        .and_then(|p| {
-            let [s, e] = osc.stretch;
-            let f0 = req.ts / p;
-            spectral::apparent_stiction_ellipse(
-                &sub.op[s - offset..e - offset],
-                &sub.pv[s - offset..e - offset],
-                0.5 * f0,
-                (1.5 * f0).min(0.5),
-            )
-        })
-        .map(|el| el.width_along_x);
-    let mut band = None;
-    if let Some(v) = valve {
-        band = Some(Band {
-            band_percent_of_span: v.d_percent_of_span,
-            op_units: v.d,
-            interval_percent_of_span: v.interval,
-            source: BandSource::Valve,
-            others: Vec::new(),
-            ellipse_percent_of_span: None,
-        });
-    } else if req.quantify {
-        let mut q = QuantifyRequest::new(ModelKind::Stenman, Method::Exact);
-        q.ts = req.ts;
-        q.max_delay = req.max_delay;
-        q.estimate_start = req.estimate_start;
-        q.integrating = Some(req.integrating);
-        match quantify(sub.op, sub.pv, &q) {
-            Ok(qr) => {
-                if let Some(b) = qr.apparent_stiction {
-                    band = Some(Band {
-                        band_percent_of_span: pct(b),
-                        op_units: b,
-                        interval_percent_of_span: qr
-                            .interval
-                            .get("d")
-                            .map(|i| [pct(i[0]), pct(i[1])]),
-                        source: BandSource::ClosedLoop,
-                        others: Vec::new(),
-                        ellipse_percent_of_span: None,
-                    });
-                }
-                d.warnings.extend(
-                    qr.warnings
-                        .iter()
-                        .map(|w| format!("closed-loop estimate: {w}")),
-                );
-                d.quantification = Some(qr);
-                d.quantified = Some([offset, offset + sub.op.len()]);
-            }
-            Err(err) => d
-                .warnings
-                .push(format!("the closed-loop estimate failed: {err}")),
-        }
+    let beside = Beside::new(d, sub, offset, osc, req.ts);
+    let (stick, describing, ellipse) = (beside.stick, beside.describing, beside.ellipse);
+    let mut band = beside.valve.map(|v| Band {
+        band_percent_of_span: v.d_percent_of_span,
+        op_units: v.d,
+        interval_percent_of_span: v.interval,
+        source: BandSource::Valve,
+        others: Vec::new(),
+        ellipse_percent_of_span: None,
+    });
+    if band.is_none() && req.quantify {
+        band = closed_loop_band(d, sub, offset, req);
     }
     if band.is_none() {
-        if let Some(f) = fits {
-            let v = f.stenman.params[0];
-            band = Some(Band {
-                band_percent_of_span: pct(v),
-                op_units: v,
-                interval_percent_of_span: None,
-                source: BandSource::FitScan,
-                others: Vec::new(),
-                ellipse_percent_of_span: None,
-            });
-        } else if let Some((t, source)) = stick
-            .map(|t| (t, BandSource::StickSlip))
-            .or(describing.map(|b| (b, BandSource::DescribingFunction)))
-        {
-            band = Some(Band {
-                band_percent_of_span: pct(t),
-                op_units: t,
-                interval_percent_of_span: None,
-                source,
-                others: Vec::new(),
-                ellipse_percent_of_span: None,
-            });
-        }
+        band = match fits {
+            Some(f) => Some(band_of(f.stenman.params[0], BandSource::FitScan, req)),
+            None => stick
+                .map(|t| band_of(t, BandSource::StickSlip, req))
+                .or(describing.map(|b| band_of(b, BandSource::DescribingFunction, req))),
+        };
     }
     let Some(mut band) = band else {
         return;
     };
+    let pct = |v: f64| req.percent_of_span(v);
     if let Some(t) = stick.filter(|_| band.source != BandSource::StickSlip) {
         band.others.push((BandSource::StickSlip, pct(t)));
     }
@@ -155,4 +141,39 @@ pub(super) fn size(
         }
     }
     d.band = Some(band);
+}
+
+/// The closed-loop estimate (`quantify`, Stenman exact) of the stretch, kept in `d`; its band.
+fn closed_loop_band(
+    d: &mut Diagnosis,
+    sub: &LoopRecord,
+    offset: usize,
+    req: &DiagnoseRequest,
+) -> Option<Band> {
+    let mut q = QuantifyRequest::new(ModelKind::Stenman, Method::Exact);
+    q.ts = req.ts;
+    q.max_delay = req.max_delay;
+    q.estimate_start = req.estimate_start;
+    q.integrating = Some(req.integrating);
+    let qr = match quantify(sub.op, sub.pv, &q) {
+        Ok(qr) => qr,
+        Err(err) => {
+            d.warnings
+                .push(format!("the closed-loop estimate failed: {err}"));
+            return None;
+        }
+    };
+    let pct = |v: f64| req.percent_of_span(v);
+    let band = qr.apparent_stiction.map(|b| Band {
+        interval_percent_of_span: qr.interval.get("d").map(|i| [pct(i[0]), pct(i[1])]),
+        ..band_of(b, BandSource::ClosedLoop, req)
+    });
+    d.warnings.extend(
+        qr.warnings
+            .iter()
+            .map(|w| format!("closed-loop estimate: {w}")),
+    );
+    d.quantification = Some(qr);
+    d.quantified = Some([offset, offset + sub.op.len()]);
+    band
 }

@@ -98,7 +98,27 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
     }
 }
 
-/// Diagnose one loop.
+/// Diagnose one loop: gate the record, judge its usable stretches with the families of evidence
+/// and, on a stiction verdict, size the band.
+///
+/// A healthy valve in the same loop as the crate root's example:
+///
+/// ```
+/// use stiction_core::diagnose::{diagnose, DiagnoseRequest, LoopRecord, Verdict};
+/// use stiction_core::models::{Model, Stenman};
+/// use stiction_core::sim::ClosedLoop;
+///
+/// let mut sim = ClosedLoop::new(Model::Stenman(Stenman::new(0.0)?));
+/// sim.samples = 1500;
+/// sim.noise = 0.05;
+/// let data = sim.run()?;
+/// let record = LoopRecord { op: &data.op, pv: &data.pv, sp: Some(&data.sp), mv: None, time: None, auto: None };
+/// let d = diagnose(&record, &DiagnoseRequest::default())?;
+/// assert_ne!(d.verdict, Verdict::Stiction);
+/// // every family says what it measured, against which threshold, and how it voted
+/// assert!(d.families.iter().all(|f| !f.threshold.is_empty()));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, DiagnoseError> {
     let started = Instant::now();
     request::check(r, req)?;

@@ -55,10 +55,9 @@ fn names(fams: &[&FamilyEvidence]) -> String {
     }
 }
 
-/// Decide from the families' votes (`oscillating`: the loop oscillates, so a record no family
-/// could judge is not short of excitation).
-pub(super) fn decide(families: &[FamilyEvidence], oscillating: bool) -> Decision {
-    let evidence: Vec<String> = families
+/// One line per family: its name, vote and note.
+fn evidence_lines(families: &[FamilyEvidence]) -> Vec<String> {
+    families
         .iter()
         .map(|f| {
             format!(
@@ -72,32 +71,44 @@ pub(super) fn decide(families: &[FamilyEvidence], oscillating: bool) -> Decision
                 f.note
             )
         })
+        .collect()
+}
+
+/// The recorded valve position decides when its family votes: the verdict, and a confidence
+/// from 0.8 (every other voting family against) to 1 (all agree).
+fn by_valve(families: &[FamilyEvidence]) -> Option<(Verdict, f64)> {
+    let valve = families
+        .iter()
+        .find(|f| f.family == Family::Valve && f.vote != Vote::Undetermined)?;
+    let others: Vec<&FamilyEvidence> = families
+        .iter()
+        .filter(|f| f.family != Family::Valve && f.vote != Vote::Undetermined)
         .collect();
+    let agree = others.iter().filter(|f| f.vote == valve.vote).count();
+    let share = if others.is_empty() {
+        1.0
+    } else {
+        agree as f64 / others.len() as f64
+    };
+    let verdict = if valve.vote == Vote::Stiction {
+        Verdict::Stiction
+    } else {
+        Verdict::NoStiction
+    };
+    Some((verdict, 0.8 + 0.2 * share))
+}
+
+/// Decide from the families' votes (`oscillating`: the loop oscillates, so a record no family
+/// could judge is not short of excitation).
+pub(super) fn decide(families: &[FamilyEvidence], oscillating: bool) -> Decision {
+    let evidence = evidence_lines(families);
     let of =
         |v: Vote| -> Vec<&FamilyEvidence> { families.iter().filter(|f| f.vote == v).collect() };
     let (pro, con) = (of(Vote::Stiction), of(Vote::NoStiction));
-    if let Some(valve) = families
-        .iter()
-        .find(|f| f.family == Family::Valve && f.vote != Vote::Undetermined)
-    {
-        let others: Vec<&FamilyEvidence> = families
-            .iter()
-            .filter(|f| f.family != Family::Valve && f.vote != Vote::Undetermined)
-            .collect();
-        let agree = others.iter().filter(|f| f.vote == valve.vote).count();
-        let share = if others.is_empty() {
-            1.0
-        } else {
-            agree as f64 / others.len() as f64
-        };
-        let verdict = if valve.vote == Vote::Stiction {
-            Verdict::Stiction
-        } else {
-            Verdict::NoStiction
-        };
+    if let Some((verdict, confidence)) = by_valve(families) {
         return Decision {
             verdict,
-            confidence: Some(0.8 + 0.2 * share),
+            confidence: Some(confidence),
             reason: None,
             next_step: next_step(verdict, families),
             evidence,

@@ -6,7 +6,7 @@
 
 use super::problem::Hammerstein;
 use super::search::Outcome;
-use crate::estimate::exact;
+use crate::estimate::{exact, IntervalKind};
 use crate::identify;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -52,9 +52,9 @@ pub(super) fn exact_stenman(
         .collect();
     let cells: Vec<CellCosts> = per_chunk.into_iter().flatten().collect();
     let kind = match (only.is_some(), full) {
-        (true, _) => "exact_staged",
-        (false, true) => "exact",
-        (false, false) => "exact_local",
+        (true, _) => IntervalKind::ExactStaged,
+        (false, true) => IntervalKind::Exact,
+        (false, false) => IntervalKind::ExactLocal,
     };
     (0..problems.len())
         .map(|s| outcome(&cells, s, (lo, hi), kind, scan.len()))
@@ -226,7 +226,7 @@ fn outcome(
     cells: &[CellCosts],
     s: usize,
     (lo, hi): (f64, f64),
-    kind: &'static str,
+    kind: IntervalKind,
     scanned: usize,
 ) -> Outcome {
     let best = cells.iter().map(|c| c.1[s]).fold(f64::INFINITY, f64::min);

@@ -4,7 +4,7 @@
 use super::problem::{range, Hammerstein};
 use super::search::Outcome;
 use crate::estimate::solver::CostFunction;
-use crate::estimate::GridSettings;
+use crate::estimate::{GridSettings, IntervalKind};
 use std::collections::BTreeMap;
 
 /// Polish a two-parameter answer by coordinate scans: each parameter in turn over a fine grid
@@ -90,7 +90,7 @@ pub(super) fn grid_search(
     Outcome {
         best,
         interval,
-        interval_kind: "grid",
+        interval_kind: IntervalKind::Grid,
         evaluations: total as u64,
         cells: None,
         top_cells: Vec::new(),

@@ -29,7 +29,10 @@ mod start;
 
 pub use compare::{compare_fits, CompareRequest, FitComparison, ModelFit};
 pub use request::QuantifyRequest;
-pub use result::{FitQuality, LinearModel, Quantification};
+pub use result::{
+    FitOutput, FitQuality, LinearFamily, LinearModel, Quantification, QuantifyStatus,
+    ValveStartKind,
+};
 
 use crate::estimate::{EstimateError, Method};
 use crate::models::ModelKind;
@@ -45,6 +48,23 @@ const STAGE_FROM: usize = 1500;
 
 /// Quantify stiction from OP and PV. Data that cannot be judged gives `status: insufficient_data`
 /// with the reason; requests that are wrong (bounds, settings) give an error.
+///
+/// A closed loop with a sticky valve, its band estimated from OP and PV alone:
+///
+/// ```
+/// use stiction_core::estimate::Method;
+/// use stiction_core::models::{Model, ModelKind, Stenman};
+/// use stiction_core::quantify::{quantify, QuantifyRequest, QuantifyStatus};
+/// use stiction_core::sim::ClosedLoop;
+///
+/// let mut sim = ClosedLoop::new(Model::Stenman(Stenman::new(2.0)?));
+/// sim.samples = 1200;
+/// let data = sim.run()?;
+/// let q = quantify(&data.op, &data.pv, &QuantifyRequest::new(ModelKind::Stenman, Method::Exact))?;
+/// assert_eq!(q.status, QuantifyStatus::Ok);
+/// assert!((q.params["d"] - 2.0).abs() < 0.2);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn quantify(
     op: &[f64],
     pv: &[f64],
@@ -87,7 +107,7 @@ pub fn quantify(
         q.evaluations += extra;
         q.seconds = started.elapsed().as_secs_f64();
         if estimate_start && q.valve_start.is_some() {
-            q.valve_start_kind = Some("estimated".into());
+            q.valve_start_kind = Some(ValveStartKind::Estimated);
         }
         q
     };
@@ -99,7 +119,7 @@ pub fn quantify(
         first.staged = false;
         first.full_partition = true;
         if let Ok((q, hint)) = quantify_inner(&op[..m], &pv[..m], &first, None) {
-            if q.status == "ok" && !hint.ranges.is_empty() {
+            if q.status == QuantifyStatus::Ok && !hint.ranges.is_empty() {
                 let (full, _) = quantify_inner(op, pv, &req, Some(&hint))?;
                 extra += q.evaluations;
                 answer = Some(full);

@@ -1,16 +1,67 @@
 //! The result of `quantify`, shared by every front end.
 
 use super::request::QuantifyRequest;
-use crate::estimate::Method;
+use crate::estimate::{IntervalKind, Method};
 use crate::models::ModelKind;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
+/// Whether a quantification reached an answer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum QuantifyStatus {
+    /// Parameters estimated.
+    Ok,
+    /// Too little usable data; `reason` says why.
+    InsufficientData,
+}
+
+/// The family of the identified linear process.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LinearFamily {
+    /// PV settles after a valve step (flow, pressure, temperature); the model's output is PV.
+    SelfRegulating,
+    /// PV ramps after a valve step (level); the model's output is PV's change per sample.
+    Integrating,
+}
+
+impl std::fmt::Display for LinearFamily {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LinearFamily::SelfRegulating => "self-regulating",
+            LinearFamily::Integrating => "integrating",
+        })
+    }
+}
+
+/// The output the R² of a fit refer to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FitOutput {
+    /// The PV itself.
+    Pv,
+    /// The PV's change per sample (integrating processes).
+    DeltaPv,
+}
+
+/// Where the valve model starts at the first sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ValveStartKind {
+    /// Where OP starts.
+    FirstOp,
+    /// The best of the candidates across the OP's span, fitted on the first samples.
+    Estimated,
+    /// Given by the caller.
+    Given,
+}
+
 /// The identified linear part.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LinearModel {
-    /// "self_regulating" (output pv) or "integrating" (output: the change of pv per sample).
-    pub family: String,
+    /// Self-regulating (output pv) or integrating (output: the change of pv per sample).
+    pub family: LinearFamily,
     pub na: usize,
     pub nb: usize,
     /// Delay in samples from valve position to output (1 = the next sample).
@@ -30,8 +81,8 @@ pub struct LinearModel {
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitQuality {
-    /// The output the R² refer to: "pv" or "delta_pv".
-    pub output: String,
+    /// The output the R² refer to: pv or its change per sample.
+    pub output: FitOutput,
     pub r2_simulation: f64,
     pub r2_one_step: f64,
     pub sse_simulation: f64,
@@ -43,8 +94,8 @@ pub struct FitQuality {
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Quantification {
-    /// "ok" or "insufficient_data".
-    pub status: String,
+    /// Whether parameters were estimated.
+    pub status: QuantifyStatus,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
     pub model: ModelKind,
@@ -54,7 +105,7 @@ pub struct Quantification {
     /// least simulation error); for other methods, along each axis with the others held at the
     /// estimate.
     pub interval: BTreeMap<String, [f64; 2]>,
-    pub interval_kind: String,
+    pub interval_kind: IntervalKind,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub linear_model: Option<LinearModel>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -75,7 +126,7 @@ pub struct Quantification {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub valve_start: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub valve_start_kind: Option<String>,
+    pub valve_start_kind: Option<ValveStartKind>,
     pub seconds: f64,
     pub samples: usize,
     pub ts: f64,
@@ -103,13 +154,13 @@ impl Quantification {
         reason: String,
     ) -> Self {
         Self {
-            status: "insufficient_data".into(),
+            status: QuantifyStatus::InsufficientData,
             reason: Some(reason),
             model: req.model,
             method: req.method,
             params: BTreeMap::new(),
             interval: BTreeMap::new(),
-            interval_kind: "none".into(),
+            interval_kind: IntervalKind::None,
             linear_model: None,
             fit: None,
             apparent_stiction: None,

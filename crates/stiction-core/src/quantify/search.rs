@@ -7,9 +7,12 @@ use super::heuristic::{axis_intervals, grid_search, polish};
 use super::pilots::{first_guesses, pilot_points, MOST_STRUCTURES, STARTING_STRUCTURES};
 use super::problem::{range, Hammerstein};
 use super::result::CAVEAT;
-use super::{quantify, FitQuality, LinearModel, Quantification, QuantifyRequest};
+use super::{
+    quantify, FitOutput, FitQuality, LinearFamily, LinearModel, Quantification, QuantifyRequest,
+    QuantifyStatus, ValveStartKind,
+};
 use crate::estimate::solver::{self, Evaluator};
-use crate::estimate::{self, aco, acor, EstimateError, Method};
+use crate::estimate::{self, aco, acor, EstimateError, IntervalKind, Method};
 use crate::identify::{self, Data, Fit, SearchRange, Structure};
 use crate::models::ModelKind;
 use crate::rng::seeded;
@@ -29,7 +32,7 @@ pub(super) struct Hint {
 pub(super) struct Outcome {
     pub(super) best: Vec<f64>,
     pub(super) interval: BTreeMap<String, [f64; 2]>,
-    pub(super) interval_kind: &'static str,
+    pub(super) interval_kind: IntervalKind,
     pub(super) evaluations: u64,
     pub(super) cells: Option<usize>,
     /// Stenman exact: the cells of least cost, best first (for a staged search).
@@ -213,7 +216,7 @@ fn starting_structures(
         work.evaluations += sq.evaluations;
         if let (Some(lm), Some(d)) = (&sq.linear_model, sq.params.get("d")) {
             queue.push_back(Structure {
-                integrating: lm.family == "integrating",
+                integrating: lm.family == LinearFamily::Integrating,
                 na: lm.na,
                 nb: lm.nb,
                 nk: lm.nk,
@@ -345,7 +348,7 @@ fn search_round(
             vec![Outcome {
                 best,
                 interval,
-                interval_kind: "axis",
+                interval_kind: IntervalKind::Axis,
                 evaluations: ev.evaluations() + extra + polish_evals,
                 cells: None,
                 top_cells: Vec::new(),
@@ -469,7 +472,7 @@ fn result(
     let s = fit.structure;
     let with_start = matches!(req.model, ModelKind::Stenman | ModelKind::He);
     Ok(Quantification {
-        status: "ok".into(),
+        status: QuantifyStatus::Ok,
         reason: None,
         model: req.model,
         method: req.method,
@@ -479,14 +482,13 @@ fn result(
             .map(|(n, &v)| (n.to_string(), v))
             .collect(),
         interval: outcome.interval,
-        interval_kind: outcome.interval_kind.into(),
+        interval_kind: outcome.interval_kind,
         linear_model: Some(LinearModel {
             family: if s.integrating {
-                "integrating"
+                LinearFamily::Integrating
             } else {
-                "self_regulating"
-            }
-            .into(),
+                LinearFamily::SelfRegulating
+            },
             na: s.na,
             nb: s.nb,
             nk: s.nk,
@@ -509,7 +511,11 @@ fn result(
             ),
         }),
         fit: Some(FitQuality {
-            output: if s.integrating { "delta_pv" } else { "pv" }.into(),
+            output: if s.integrating {
+                FitOutput::DeltaPv
+            } else {
+                FitOutput::Pv
+            },
             r2_simulation: fit.r2_simulation(),
             r2_one_step: fit.r2_one_step(),
             sse_simulation: fit.sse_simulation,
@@ -523,11 +529,10 @@ fn result(
         valve_start: with_start.then(|| req.valve_start.unwrap_or(op[0])),
         valve_start_kind: with_start.then(|| {
             if req.valve_start.is_some() {
-                "given"
+                ValveStartKind::Given
             } else {
-                "first_op"
+                ValveStartKind::FirstOp
             }
-            .to_string()
         }),
         seconds: started.elapsed().as_secs_f64(),
         samples: op.len(),

@@ -1,7 +1,7 @@
 //! Where the valve stood at the first sample.
 
 use super::search::quantify_inner;
-use super::{problem::range, QuantifyRequest};
+use super::{problem::range, QuantifyRequest, QuantifyStatus};
 
 /// A record rarely starts just as the valve moved, and a Stenman valve started elsewhere can stay
 /// out of step with the real one for good. Each candidate position at the first sample (the first
@@ -20,7 +20,7 @@ pub(super) fn best_start(op: &[f64], pv: &[f64], req: &QuantifyRequest) -> (Opti
         };
         evaluations += q.evaluations;
         if let Some(sse) = q.fit.as_ref().map(|f| f.sse_simulation) {
-            if q.status == "ok" && best.is_none_or(|b| sse < b.0) {
+            if q.status == QuantifyStatus::Ok && best.is_none_or(|b| sse < b.0) {
                 best = Some((sse, x0));
             }
         }

@@ -222,6 +222,21 @@ impl ClosedLoop {
     /// Run the loop. Each controller period: measure pv, compute the error, the PI move (clamped
     /// to 0..100), the valve position; the process sees the valve position `delay` later. The
     /// process starts at steady state with pv = sp[0] and op = mv = op0.
+    ///
+    /// ```
+    /// use stiction_core::models::{Kano, Model};
+    /// use stiction_core::sim::ClosedLoop;
+    ///
+    /// let mut sim = ClosedLoop::new(Model::Kano(Kano::new(2.0, 1.0)?));
+    /// sim.samples = 600;
+    /// sim.seed = 7;
+    /// let data = sim.run()?;
+    /// assert_eq!(data.pv.len(), 600);
+    /// // the valve sticks: it holds its position while OP moves
+    /// let held = data.mv.windows(2).filter(|w| w[0] == w[1]).count();
+    /// assert!(held > 100);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn run(&self) -> Result<LoopData, SimError> {
         Ok(self.simulate()?.data)
     }

@@ -16,6 +16,7 @@
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
 use crate::diagnose::result::Vote;
 use crate::identify::Structure;
+use crate::quantify::FitComparison;
 use serde::{Deserialize, Serialize};
 
 /// The model family.
@@ -101,6 +102,7 @@ pub struct ModelEvidence {
 }
 
 /// The statistics of a comparison: shares of the compared output's variance above its noise.
+#[derive(Clone, Copy)]
 struct Levels {
     noise_share: f64,
     improvement: f64,
@@ -150,38 +152,9 @@ impl EvidenceFamily for Model {
             );
         };
         let levels = Levels::of(f);
-        let Levels {
-            noise_share,
-            improvement,
-            significance,
-            explained,
-        } = levels;
+        let improvement = levels.improvement;
         let d = f.stenman.params[0];
-        let evidence = ModelEvidence {
-            structure: f.structure,
-            r2_without_stiction: f.linear.r2,
-            r2_stenman: f.stenman.r2,
-            r2_slip_jump: f.slip_jump.r2,
-            stenman_d: d,
-            stenman_d_percent_of_span: ctx.req.percent_of_span(d),
-            kano_s: f.slip_jump.params[0],
-            kano_j: f.slip_jump.params[1],
-            improvement,
-            significance,
-            explained,
-            noise_share,
-            gain: f.gain,
-            time_constant: f.time_constant,
-            dead_time: f.dead_time,
-            samples: f.samples_used,
-            lag: f.lag,
-            valve_start: f.valve_start,
-            sst: f.sst,
-            sse_linear: f.linear.sse,
-            sse_stiction: f.stenman.sse.min(f.slip_jump.sse),
-            sse_noise: f.samples_used as f64 * f.noise_var,
-            calibration: CALIBRATION.into(),
-        };
+        let evidence = model_evidence(ctx, f, &levels);
         let fits = format!(
             "R² {:.3} without stiction, {:.3} with (Stenman d = {:.2} % of span; Kano S = {:.2}, J = {:.2})",
             f.linear.r2,
@@ -190,75 +163,7 @@ impl EvidenceFamily for Model {
             evidence.kano_s,
             evidence.kano_j
         );
-        let independent = f.samples_used as f64 / f.lag.max(1) as f64;
-        let (vote, strength, why) = if independent < MIN_INDEPENDENT {
-            (
-                Vote::Undetermined,
-                0.0,
-                format!(
-                    "only {independent:.0} independent changes over {} samples: too few for the test",
-                    f.lag
-                ),
-            )
-        } else if 1.0 - noise_share < MIN_SIGNAL_SHARE {
-            (
-                Vote::Undetermined,
-                0.0,
-                format!(
-                    "the PV barely varies above its noise ({:.0} % of its variance is noise): nothing for a fit to explain",
-                    100.0 * noise_share
-                ),
-            )
-        } else if explained < MIN_EXPLAINED {
-            (
-                Vote::NoStiction,
-                ELSEWHERE_STRENGTH,
-                format!(
-                    "OP explains only {:.0} % of the PV's variation above its noise through any valve: the variation enters the loop elsewhere",
-                    100.0 * explained.max(0.0)
-                ),
-            )
-        } else if significance >= SIGNIFICANCE_STICTION {
-            (
-                Vote::Stiction,
-                (0.5 + 0.5 * (significance / SIGNIFICANCE_STICTION).ln()
-                    / (SIGNIFICANCE_DECISIVE / SIGNIFICANCE_STICTION).ln())
-                .min(1.0),
-                format!(
-                    "a sticky valve explains {:.1} % more of the PV's variation above its noise than a valve that follows OP, far beyond what a free band gains on healthy loops (test ratio {significance:.0})",
-                    100.0 * improvement
-                ),
-            )
-        } else if significance <= SIGNIFICANCE_NONE && limit_cycles(ctx) {
-            // a regular cycle is a few harmonics: linear dynamics from OP fit it about as well as
-            // the valve that causes it, so fits alike are no evidence either way
-            (
-                Vote::Undetermined,
-                0.0,
-                format!(
-                    "a stiction band improves the fit by {:.1} % of the PV's variation above its noise, but the loop limit-cycles: a regular cycle is fitted about as well by linear dynamics from OP as by the valve that causes it (test ratio {significance:.0})",
-                    100.0 * improvement.max(0.0)
-                ),
-            )
-        } else if significance <= SIGNIFICANCE_NONE {
-            (
-                Vote::NoStiction,
-                NONE_STRENGTH,
-                format!(
-                    "a stiction band improves the fit by {:.1} % of the PV's variation above its noise, no more than healthy loops gain (test ratio {significance:.0})",
-                    100.0 * improvement.max(0.0)
-                ),
-            )
-        } else {
-            (
-                Vote::Undetermined,
-                0.0,
-                format!(
-                    "a stiction band improves the fit by {:.1} % of the PV's variation above its noise: more than most healthy loops gain, too little to decide (test ratio {significance:.0})",
-                    100.0 * improvement
-                ),
-            )
-        };
+        let (vote, strength, why) = vote(ctx, f, &levels);
         FamilyEvidence {
             family: Family::Model,
             vote,
@@ -272,5 +177,120 @@ impl EvidenceFamily for Model {
             valve: None,
             limit_cycle: None,
         }
+    }
+}
+
+/// The fits' figures, as the result reports them.
+fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvidence {
+    let Levels {
+        noise_share,
+        improvement,
+        significance,
+        explained,
+    } = *levels;
+    let d = f.stenman.params[0];
+    ModelEvidence {
+        structure: f.structure,
+        r2_without_stiction: f.linear.r2,
+        r2_stenman: f.stenman.r2,
+        r2_slip_jump: f.slip_jump.r2,
+        stenman_d: d,
+        stenman_d_percent_of_span: ctx.req.percent_of_span(d),
+        kano_s: f.slip_jump.params[0],
+        kano_j: f.slip_jump.params[1],
+        improvement,
+        significance,
+        explained,
+        noise_share,
+        gain: f.gain,
+        time_constant: f.time_constant,
+        dead_time: f.dead_time,
+        samples: f.samples_used,
+        lag: f.lag,
+        valve_start: f.valve_start,
+        sst: f.sst,
+        sse_linear: f.linear.sse,
+        sse_stiction: f.stenman.sse.min(f.slip_jump.sse),
+        sse_noise: f.samples_used as f64 * f.noise_var,
+        calibration: CALIBRATION.into(),
+    }
+}
+
+/// The vote, its strength and why, from the fits' levels.
+fn vote(ctx: &Context, f: &FitComparison, levels: &Levels) -> (Vote, f64, String) {
+    let Levels {
+        noise_share,
+        improvement,
+        significance,
+        explained,
+    } = *levels;
+    let independent = f.samples_used as f64 / f.lag.max(1) as f64;
+    if independent < MIN_INDEPENDENT {
+        (
+            Vote::Undetermined,
+            0.0,
+            format!(
+                "only {independent:.0} independent changes over {} samples: too few for the test",
+                f.lag
+            ),
+        )
+    } else if 1.0 - noise_share < MIN_SIGNAL_SHARE {
+        (
+            Vote::Undetermined,
+            0.0,
+            format!(
+                "the PV barely varies above its noise ({:.0} % of its variance is noise): nothing for a fit to explain",
+                100.0 * noise_share
+            ),
+        )
+    } else if explained < MIN_EXPLAINED {
+        (
+            Vote::NoStiction,
+            ELSEWHERE_STRENGTH,
+            format!(
+                "OP explains only {:.0} % of the PV's variation above its noise through any valve: the variation enters the loop elsewhere",
+                100.0 * explained.max(0.0)
+            ),
+        )
+    } else if significance >= SIGNIFICANCE_STICTION {
+        (
+            Vote::Stiction,
+            (0.5 + 0.5 * (significance / SIGNIFICANCE_STICTION).ln()
+                / (SIGNIFICANCE_DECISIVE / SIGNIFICANCE_STICTION).ln())
+            .min(1.0),
+            format!(
+                "a sticky valve explains {:.1} % more of the PV's variation above its noise than a valve that follows OP, far beyond what a free band gains on healthy loops (test ratio {significance:.0})",
+                100.0 * improvement
+            ),
+        )
+    } else if significance <= SIGNIFICANCE_NONE && limit_cycles(ctx) {
+        // a regular cycle is a few harmonics: linear dynamics from OP fit it about as well as
+        // the valve that causes it, so fits alike are no evidence either way
+        (
+            Vote::Undetermined,
+            0.0,
+            format!(
+                "a stiction band improves the fit by {:.1} % of the PV's variation above its noise, but the loop limit-cycles: a regular cycle is fitted about as well by linear dynamics from OP as by the valve that causes it (test ratio {significance:.0})",
+                100.0 * improvement.max(0.0)
+            ),
+        )
+    } else if significance <= SIGNIFICANCE_NONE {
+        (
+            Vote::NoStiction,
+            NONE_STRENGTH,
+            format!(
+                "a stiction band improves the fit by {:.1} % of the PV's variation above its noise, no more than healthy loops gain (test ratio {significance:.0})",
+                100.0 * improvement.max(0.0)
+            ),
+        )
+    } else {
+        (
+            Vote::Undetermined,
+            0.0,
+            format!(
+                "a stiction band improves the fit by {:.1} % of the PV's variation above its noise: more than most healthy loops gain, too little to decide (test ratio {significance:.0})",
+                100.0 * improvement
+            ),
+        )
     }
 }

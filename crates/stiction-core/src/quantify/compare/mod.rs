@@ -125,74 +125,31 @@ const INTEGRATING_LAG_SHARE: usize = 25;
 /// Compare the closed-loop fits with and without stiction. `None` when no linear model can be
 /// fitted (too few samples, OP or PV constant).
 pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitComparison> {
-    let n = op.len();
     let (lo, hi) = range(op);
     let op_range = hi - lo;
-    if n != pv.len() || op_range.is_nan() || op_range <= 0.0 || range(pv).1 <= range(pv).0 {
+    if op.len() != pv.len() || op_range.is_nan() || op_range <= 0.0 || range(pv).1 <= range(pv).0 {
         return None;
     }
-    let mut search = SearchRange::new(req.max_delay.min(n / 20).max(1));
-    if let Some(integrating) = req.integrating {
-        search.integrating = integrating;
-        search.self_regulating = !integrating;
-    }
-    let t0 = search.t0();
-    let offset = op.iter().sum::<f64>() / n as f64;
-    let op_centred: Vec<f64> = op.iter().map(|v| v - offset).collect();
-    // the lag: the response time of a first linear fit on levels
-    let levels = Data::new(pv, t0);
-    let first = identify::select(&levels, &op_centred, &search)?.structure;
-    let first_fit = identify::fit(&levels, &op_centred, first)?;
-    let phys = identify::physical(&first_fit, req.ts);
-    let response = phys.time_constant.unwrap_or(0.0) + phys.dead_time;
-    // (an oscillating sticky loop's linear fit on levels is poor: its response time is read off
-    // the PV's autocorrelation too, whichever is longer)
-    let mut lag = ((LAG_RESPONSES * response / req.ts).round() as usize).max(half_correlation(pv));
-    if first.integrating {
-        // a level's change grows with the lag while its noise does not: a long lag
-        lag = lag.max(n / INTEGRATING_LAG_SHARE);
-    }
-    let lag = lag.clamp(MIN_LAG, (n / MAX_LAG_SHARE).max(MIN_LAG));
-    if n < lag + t0 + 20 * (search.na.len() + search.nb_max + 1) {
-        return None;
-    }
-    // changes over the lag are bounded even for an integrating process (over the lag its level
-    // changes by the sum of its inflow): compared with self-regulating structures, whose
-    // simulation errors are those of the PV's changes, not of its noisy rate
-    search.integrating = false;
-    search.self_regulating = true;
-    let mut y = vec![0.0; n - lag];
-    difference(pv, lag, &mut y);
-    let data = Data::new(&y, t0);
-    let mut linear_mv = vec![0.0; n - lag];
-    difference(op, lag, &mut linear_mv);
-    let s0 = identify::select(&data, &linear_mv, &search)?.structure;
+    let setup = Setup::new(op, pv, req)?;
+    let data = Data::new(&setup.y, setup.t0);
     let problem = Problem {
         op,
         data: &data,
-        lag,
+        lag: setup.lag,
         start: None,
     };
     let mut evaluations = 3;
     // the structures: the linear loop's, and those chosen at a few bands across the OP range
-    let mut structures = vec![s0];
-    for f in PILOT_BANDS {
-        let m = Model::Stenman(Stenman::new(f * op_range).ok()?);
-        if let Some(sel) = identify::select(&data, &problem.valve(&m), &search) {
-            if !structures.contains(&sel.structure) {
-                structures.push(sel.structure);
-            }
-        }
-        evaluations += 1;
-    }
-    let (x0, walked) = valve_start(op, &y, t0, lag, &structures, op_range);
+    let s0 = identify::select(&data, &setup.linear_mv, &setup.search)?.structure;
+    let structures = pilot_structures(&problem, &setup.search, s0, op_range, &mut evaluations)?;
+    let (x0, walked) = valve_start(op, &setup.y, setup.t0, setup.lag, &structures, op_range);
     evaluations += walked;
     let problem = Problem {
         start: Some(x0),
         ..problem
     };
     // the Stenman band, exactly: every distinct valve trajectory, under each structure
-    let (bands, walked) = exact_band(op, &y, &data, &structures, op_range, lag, x0);
+    let (bands, walked) = exact_band(op, &setup.y, &data, &structures, op_range, setup.lag, x0);
     evaluations += walked;
     // the linear loop and each structure's stiction fit, over the structures and their
     // neighbours, each moved to its output-error optimum: the comparison is fair only at both
@@ -203,40 +160,161 @@ pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitC
             tried.push(s);
         }
     }
-    // (the few structures whose least-squares fits simulate best are refined)
-    let optimum = |mv: &[f64], among: &[Structure]| -> Option<Fit> {
-        let mut fits: Vec<Fit> = among
-            .iter()
-            .filter_map(|&s| identify::fit(&data, mv, s).filter(Fit::stable))
-            .collect();
-        fits.sort_by(|x, y| x.sse_simulation.total_cmp(&y.sse_simulation));
-        fits.truncate(REFINED_STRUCTURES);
-        fits.iter()
-            .map(|f| identify::refine_output_error(&data, mv, f, OE_ITERATIONS))
-            .min_by(|x, y| x.sse_simulation.total_cmp(&y.sse_simulation))
-            .and_then(|f| identify::polish_output_error(&data, mv, &f))
-    };
-    let linear_fit = optimum(&linear_mv, &tried);
+    let linear_fit = optimum(&data, &setup.linear_mv, &tried);
     evaluations += tried.len() as u64;
-    let mut stenman_fit: Option<(Model, Fit)> = None;
-    for &(d, s) in &bands {
-        let Ok(m) = Stenman::new(d).map(Model::Stenman) else {
-            continue;
-        };
-        if let Some(f) = optimum(&problem.valve(&m), &neighbours(s)) {
-            if stenman_fit
-                .as_ref()
-                .is_none_or(|b| f.sse_simulation < b.1.sse_simulation)
-            {
-                stenman_fit = Some((m, f));
+    let (best_model, fit_stenman) = bands
+        .iter()
+        .filter_map(|&(d, s)| {
+            let m = Stenman::new(d).map(Model::Stenman).ok()?;
+            optimum(&data, &problem.valve(&m), &neighbours(s)).map(|f| (m, f))
+        })
+        .fold(None, |best: Option<(Model, Fit)>, (m, f)| match best {
+            Some(b) if b.1.sse_simulation <= f.sse_simulation => Some(b),
+            _ => Some((m, f)),
+        })?;
+    let best = (best_model, fit_stenman.sse_simulation);
+    let (slip, fit_slip) = slip_jump(&problem, &best, &fit_stenman, op_range, &mut evaluations);
+    let (stiction, fit_s) = if slip.1 < best.1 {
+        (&slip, fit_slip)
+    } else {
+        (&best, fit_stenman)
+    };
+    // the linear loop may do as well from the stiction fit's dynamics: a comparison of fits is
+    // fair only when neither optimisation stopped short
+    let linear_fit = match (
+        linear_fit,
+        identify::polish_output_error(&data, &setup.linear_mv, &fit_s),
+    ) {
+        (Some(a), Some(b)) => Some(if b.sse_simulation < a.sse_simulation {
+            b
+        } else {
+            a
+        }),
+        (a, b) => a.or(b),
+    };
+    let fits = Fits {
+        linear: linear_fit,
+        stenman: best,
+        slip_jump: slip,
+        stiction: stiction.0,
+        stiction_fit: fit_s,
+        x0,
+        samples_used: data.used(),
+        evaluations,
+    };
+    Some(fits.into_comparison(op, pv, &setup, req))
+}
+
+/// The compared output and the search every fit shares.
+struct Setup {
+    search: SearchRange,
+    t0: usize,
+    lag: usize,
+    /// The mean OP, taken from the valve position before fitting levels.
+    offset: f64,
+    op_centred: Vec<f64>,
+    /// PV's changes over the lag, and OP's.
+    y: Vec<f64>,
+    linear_mv: Vec<f64>,
+}
+
+impl Setup {
+    fn new(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<Self> {
+        let n = op.len();
+        let mut search = SearchRange::new(req.max_delay.min(n / 20).max(1));
+        if let Some(integrating) = req.integrating {
+            search.integrating = integrating;
+            search.self_regulating = !integrating;
+        }
+        let t0 = search.t0();
+        let offset = op.iter().sum::<f64>() / n as f64;
+        let op_centred: Vec<f64> = op.iter().map(|v| v - offset).collect();
+        // the lag: the response time of a first linear fit on levels
+        let levels = Data::new(pv, t0);
+        let first = identify::select(&levels, &op_centred, &search)?.structure;
+        let first_fit = identify::fit(&levels, &op_centred, first)?;
+        let phys = identify::physical(&first_fit, req.ts);
+        let response = phys.time_constant.unwrap_or(0.0) + phys.dead_time;
+        // (an oscillating sticky loop's linear fit on levels is poor: its response time is read
+        // off the PV's autocorrelation too, whichever is longer)
+        let mut lag =
+            ((LAG_RESPONSES * response / req.ts).round() as usize).max(half_correlation(pv));
+        if first.integrating {
+            // a level's change grows with the lag while its noise does not: a long lag
+            lag = lag.max(n / INTEGRATING_LAG_SHARE);
+        }
+        let lag = lag.clamp(MIN_LAG, (n / MAX_LAG_SHARE).max(MIN_LAG));
+        if n < lag + t0 + 20 * (search.na.len() + search.nb_max + 1) {
+            return None;
+        }
+        // changes over the lag are bounded even for an integrating process (over the lag its
+        // level changes by the sum of its inflow): compared with self-regulating structures,
+        // whose simulation errors are those of the PV's changes, not of its noisy rate
+        search.integrating = false;
+        search.self_regulating = true;
+        let mut y = vec![0.0; n - lag];
+        difference(pv, lag, &mut y);
+        let mut linear_mv = vec![0.0; n - lag];
+        difference(op, lag, &mut linear_mv);
+        Some(Self {
+            search,
+            t0,
+            lag,
+            offset,
+            op_centred,
+            y,
+            linear_mv,
+        })
+    }
+}
+
+/// The linear loop's structure and those chosen again with Stenman valves of a few bands.
+fn pilot_structures(
+    problem: &Problem,
+    search: &SearchRange,
+    s0: Structure,
+    op_range: f64,
+    evaluations: &mut u64,
+) -> Option<Vec<Structure>> {
+    let mut structures = vec![s0];
+    for f in PILOT_BANDS {
+        let m = Model::Stenman(Stenman::new(f * op_range).ok()?);
+        if let Some(sel) = identify::select(problem.data, &problem.valve(&m), search) {
+            if !structures.contains(&sel.structure) {
+                structures.push(sel.structure);
             }
         }
+        *evaluations += 1;
     }
-    let (best_model, fit_stenman) = stenman_fit?;
-    let structure = fit_stenman.structure;
-    let best = (best_model, fit_stenman.sse_simulation);
+    Some(structures)
+}
+
+/// The fit at its output-error optimum of the few structures among `among` whose least-squares
+/// fits simulate best.
+fn optimum(data: &Data, mv: &[f64], among: &[Structure]) -> Option<Fit> {
+    let mut fits: Vec<Fit> = among
+        .iter()
+        .filter_map(|&s| identify::fit(data, mv, s).filter(Fit::stable))
+        .collect();
+    fits.sort_by(|x, y| x.sse_simulation.total_cmp(&y.sse_simulation));
+    fits.truncate(REFINED_STRUCTURES);
+    fits.iter()
+        .map(|f| identify::refine_output_error(data, mv, f, OE_ITERATIONS))
+        .min_by(|x, y| x.sse_simulation.total_cmp(&y.sse_simulation))
+        .and_then(|f| identify::polish_output_error(data, mv, &f))
+}
+
+/// Kano's band S and slip jump J around the Stenman band `best` (J = S is close to Stenman's
+/// valve), never worse than Stenman's valve (which is a slip-jump valve too).
+fn slip_jump(
+    problem: &Problem,
+    best: &(Model, f64),
+    fit_stenman: &Fit,
+    op_range: f64,
+    evaluations: &mut u64,
+) -> ((Model, f64), Fit) {
     let d = best.0.values()[0];
-    // Kano's band S and slip jump J around the Stenman band (J = S is close to Stenman's valve)
+    let structure = fit_stenman.structure;
     let mut kano: Vec<Model> = Vec::new();
     for fs in [0.5, 0.75, 1.0, 1.25, 1.5, 2.0] {
         for fj in [0.0, 0.25, 0.5, 0.75, 1.0] {
@@ -247,82 +325,95 @@ pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitC
         }
     }
     let mut slip = problem.best_of(structure, &kano);
-    evaluations += kano.len() as u64;
-    let fit_slip = optimum(&problem.valve(&slip.0), &neighbours(structure))
-        .unwrap_or_else(|| fit_stenman.clone());
+    *evaluations += kano.len() as u64;
+    let fit_slip = optimum(
+        problem.data,
+        &problem.valve(&slip.0),
+        &neighbours(structure),
+    )
+    .unwrap_or_else(|| fit_stenman.clone());
     slip.1 = slip.1.min(fit_slip.sse_simulation);
     if best.1 < slip.1 {
-        // Stenman's valve is a slip-jump valve too: never report a worse fit for the family
-        slip = best;
+        slip = *best;
     }
-    let (stiction, fit_s) = if slip.1 < best.1 {
-        (&slip, fit_slip)
-    } else {
-        (&best, fit_stenman)
-    };
-    // the linear loop may do as well from the stiction fit's dynamics: a comparison of fits is
-    // fair only when neither optimisation stopped short
-    let linear_fit = match (
-        linear_fit,
-        identify::polish_output_error(&data, &linear_mv, &fit_s),
-    ) {
-        (Some(a), Some(b)) => Some(if b.sse_simulation < a.sse_simulation {
-            b
-        } else {
-            a
-        }),
-        (a, b) => a.or(b),
-    };
-    let sst = fit_s.sst;
-    let phys = identify::physical(&fit_s, req.ts);
-    let mv_stiction = stiction.0.simulate_from(op, Some(x0));
-    let mv_centred: Vec<f64> = mv_stiction.iter().map(|v| v - offset).collect();
-    let pv_stiction = identify::simulate_pv(&levels, &mv_centred, &fit_s);
-    let pv_linear = linear_fit
-        .as_ref()
-        .map(|f| identify::simulate_pv(&levels, &op_centred, f))
-        .unwrap_or_default();
-    let r2 = |sse: f64| 1.0 - sse / sst;
-    let linear_sse = linear_fit
-        .as_ref()
-        .map_or(sst, |f| f.sse_simulation.min(sst));
-    // the compared output's noise: white noise differenced over the lag (twice again for an
-    // integrating structure's change)
-    let sigma = measurement_noise(pv);
-    let noise_var = 2.0 * sigma * sigma;
-    Some(FitComparison {
-        structure,
-        lag,
-        samples_used: data.used(),
-        sst,
-        noise_var,
-        valve_start: x0,
-        linear: ModelFit {
-            params: Vec::new(),
-            sse: linear_sse,
-            r2: r2(linear_sse),
-        },
-        stenman: ModelFit {
-            params: vec![d],
-            sse: best.1,
-            r2: r2(best.1),
-        },
-        slip_jump: ModelFit {
-            params: stiction_params(&slip.0),
-            sse: slip.1,
-            r2: r2(slip.1),
-        },
-        gain: phys.gain,
-        time_constant: phys.time_constant,
-        dead_time: phys.dead_time,
-        evaluations,
-        pv_linear,
-        pv_stiction,
-        mv_stiction,
-        linear_model: linear_fit,
-        stiction_model: Some(fit_s),
-        op_offset: offset,
-    })
+    (slip, fit_slip)
+}
+
+/// The compared fits, before they are put in words and R².
+struct Fits {
+    linear: Option<Fit>,
+    stenman: (Model, f64),
+    slip_jump: (Model, f64),
+    /// The better of the two stiction models, and its linear part.
+    stiction: Model,
+    stiction_fit: Fit,
+    x0: f64,
+    samples_used: usize,
+    evaluations: u64,
+}
+
+impl Fits {
+    fn into_comparison(
+        self,
+        op: &[f64],
+        pv: &[f64],
+        setup: &Setup,
+        req: &CompareRequest,
+    ) -> FitComparison {
+        let fit_s = self.stiction_fit;
+        let sst = fit_s.sst;
+        let phys = identify::physical(&fit_s, req.ts);
+        let levels = Data::new(pv, setup.t0);
+        let mv_stiction = self.stiction.simulate_from(op, Some(self.x0));
+        let mv_centred: Vec<f64> = mv_stiction.iter().map(|v| v - setup.offset).collect();
+        let pv_stiction = identify::simulate_pv(&levels, &mv_centred, &fit_s);
+        let pv_linear = self
+            .linear
+            .as_ref()
+            .map(|f| identify::simulate_pv(&levels, &setup.op_centred, f))
+            .unwrap_or_default();
+        let r2 = |sse: f64| 1.0 - sse / sst;
+        let linear_sse = self
+            .linear
+            .as_ref()
+            .map_or(sst, |f| f.sse_simulation.min(sst));
+        // the compared output's noise: white noise differenced over the lag (twice again for an
+        // integrating structure's change)
+        let sigma = measurement_noise(pv);
+        FitComparison {
+            structure: fit_s.structure,
+            lag: setup.lag,
+            samples_used: self.samples_used,
+            sst,
+            noise_var: 2.0 * sigma * sigma,
+            valve_start: self.x0,
+            linear: ModelFit {
+                params: Vec::new(),
+                sse: linear_sse,
+                r2: r2(linear_sse),
+            },
+            stenman: ModelFit {
+                params: vec![self.stenman.0.values()[0]],
+                sse: self.stenman.1,
+                r2: r2(self.stenman.1),
+            },
+            slip_jump: ModelFit {
+                params: stiction_params(&self.slip_jump.0),
+                sse: self.slip_jump.1,
+                r2: r2(self.slip_jump.1),
+            },
+            gain: phys.gain,
+            time_constant: phys.time_constant,
+            dead_time: phys.dead_time,
+            evaluations: self.evaluations,
+            pv_linear,
+            pv_stiction,
+            mv_stiction,
+            linear_model: self.linear,
+            stiction_model: Some(fit_s),
+            op_offset: setup.offset,
+        }
+    }
 }
 
 /// The first lag at which the autocorrelation of the PV (its straight-line trend removed) falls
