@@ -28,7 +28,7 @@ mod stop;
 mod summary;
 
 use crate::atomic::{remove_stale_temps, write_atomic};
-use crate::cmd_diagnose::Columns;
+use crate::loop_file::Columns;
 use anyhow::{bail, Context, Result};
 use layout::{Layout, LoopList, TagPattern};
 use pipeline::Ctx;

@@ -3,7 +3,7 @@ use crate::words::count;
 use crate::{cmd_simulate::write_atomic, data, spec};
 use anyhow::{bail, Result};
 use std::path::PathBuf;
-use stiction_core::estimate::{self, Estimate, Method, Request};
+use stiction_core::estimate::{self, Estimate, IntervalKind, Method, Request};
 use stiction_core::models::ModelKind;
 
 #[derive(clap::Args)]
@@ -209,7 +209,7 @@ fn print_human(file: &str, e: &Estimate) {
             spec.name, spec.unit, spec.description
         );
         if let Some([lo, hi]) = e.interval.get(spec.name) {
-            if e.interval_kind == "exact" {
+            if e.interval_kind == IntervalKind::Exact {
                 print!("; proven optimal set [{lo:.4}, {hi:.4})");
             } else {
                 print!("; grid points at the minimum span [{lo:.4}, {hi:.4}]");

@@ -4,7 +4,11 @@ use crate::words::{count, seconds};
 use crate::{data, spec};
 use anyhow::{bail, Result};
 use std::path::{Path, PathBuf};
-use stiction_core::quantify::{quantify, Quantification, QuantifyRequest};
+use stiction_core::estimate::IntervalKind;
+use stiction_core::quantify::{
+    quantify, FitOutput, LinearFamily, Quantification, QuantifyRequest, QuantifyStatus,
+    ValveStartKind,
+};
 
 #[derive(clap::Args)]
 #[command(after_help = "Examples:
@@ -141,7 +145,7 @@ pub fn run(a: Args) -> Result<()> {
     let notes: Vec<&String> = stretch.note.iter().chain(&lf.notes).collect();
 
     if let Some(dir) = &a.plot {
-        if q.status == "ok" {
+        if q.status == QuantifyStatus::Ok {
             let t: Vec<f64> = match &time {
                 // seconds from the first sample (text timestamps are seconds since 1970)
                 Some(t) => t.iter().map(|v| v - t[0]).collect(),
@@ -157,7 +161,7 @@ pub fn run(a: Args) -> Result<()> {
         }
         return Ok(());
     }
-    if q.status != "ok" {
+    if q.status != QuantifyStatus::Ok {
         let which = if stretch.note.is_some() {
             format!(
                 " (in the longest stretch without gaps, {} to {})",
@@ -196,33 +200,36 @@ fn print_human(file: &str, q: &Quantification, plot_dir: Option<&Path>) {
         let v = q.params[spec.name];
         print!("    {} = {v:.4} ({})", spec.name, spec.description);
         if let Some([lo, hi]) = q.interval.get(spec.name) {
-            let what = match q.interval_kind.as_str() {
-                "exact" => "every value in",
-                "exact_local" => "every value (exact near the best scan points) in",
-                "exact_staged" => {
+            let what = match q.interval_kind {
+                IntervalKind::Exact => "every value in",
+                IntervalKind::ExactLocal => "every value (exact near the best scan points) in",
+                IntervalKind::ExactStaged => {
                     "every value (exact over the cells kept from a search of the first samples) in"
                 }
-                "grid" => "grid points at the minimum span",
-                _ => "fits equally well with the others fixed over",
+                IntervalKind::Grid => "grid points at the minimum span",
+                IntervalKind::Axis | IntervalKind::None => {
+                    "fits equally well with the others fixed over"
+                }
             };
             print!("; {what} [{lo:.4}, {hi:.4}]");
         }
         println!();
     }
-    if let (Some(x0), Some(kind)) = (q.valve_start, q.valve_start_kind.as_deref()) {
+    if let (Some(x0), Some(kind)) = (q.valve_start, q.valve_start_kind) {
         println!(
             "  valve at the first sample: {x0:.3} ({})",
             match kind {
-                "estimated" => "estimated: the best of candidates across the OP's span",
-                "given" => "given",
-                _ => "assumed at the first OP; --estimate-start estimates it",
+                ValveStartKind::Estimated =>
+                    "estimated: the best of candidates across the OP's span",
+                ValveStartKind::Given => "given",
+                ValveStartKind::FirstOp => "assumed at the first OP; --estimate-start estimates it",
             }
         );
     }
     if let Some(lm) = &q.linear_model {
         let mut phys = Vec::new();
         if let Some(g) = lm.gain {
-            phys.push(if lm.family == "integrating" {
+            phys.push(if lm.family == LinearFamily::Integrating {
                 format!("integration rate {g:.4} per s")
             } else {
                 format!("gain {g:.3}")
@@ -234,7 +241,7 @@ fn print_human(file: &str, q: &Quantification, plot_dir: Option<&Path>) {
         phys.push(format!("dead time {:.1} s", lm.dead_time));
         println!(
             "  linear model: {} ARX, na = {}, nb = {}, delay {} samples: {}",
-            lm.family.replace('_', "-"),
+            lm.family,
             lm.na,
             lm.nb,
             lm.nk,
@@ -244,7 +251,7 @@ fn print_human(file: &str, q: &Quantification, plot_dir: Option<&Path>) {
     if let Some(f) = &q.fit {
         println!(
             "  fit of {}: R² {:.4} in simulation, {:.4} one step ahead",
-            if f.output == "pv" {
+            if f.output == FitOutput::Pv {
                 "PV"
             } else {
                 "the PV's change per sample"

@@ -2,7 +2,7 @@
 //! inline CSS, no scripts, fonts, images or links outside the file, readable on a laptop, a phone
 //! and on paper. The page itself is [`crate::report`]'s.
 
-use crate::cmd_diagnose::Columns;
+use crate::loop_file::Columns;
 use crate::report::{self, PageOptions};
 use crate::words::verdict;
 use anyhow::Result;
@@ -30,7 +30,7 @@ pub struct Args {
     pub output: PathBuf,
     /// Exit with code 4 when the verdict is stiction (after writing the report), for scripts
     #[arg(long, value_enum, value_name = "VERDICT")]
-    pub fail_on: Option<crate::cmd_diagnose::FailOn>,
+    pub fail_on: Option<crate::exit::FailOn>,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -41,7 +41,7 @@ pub fn run(a: Args) -> Result<()> {
     req.quantify = !a.no_quantify;
     let id = table.path.display().to_string();
     let d =
-        diagnose(&lf.record(), &req).map_err(|e| crate::cmd_diagnose::core_error(&id, &lf, e))?;
+        diagnose(&lf.record(), &req).map_err(|e| crate::loop_messages::core_error(&id, &lf, e))?;
     let options = PageOptions {
         columns: Some(&a.columns),
         back_link: None,
@@ -55,6 +55,6 @@ pub fn run(a: Args) -> Result<()> {
             .unwrap_or_default(),
         a.output.display()
     );
-    crate::cmd_diagnose::print_notes(&id, &lf, false);
-    crate::cmd_diagnose::FailOn::check(a.fail_on, d.verdict)
+    crate::loop_messages::print_notes(&id, &lf, false);
+    crate::exit::FailOn::check(a.fail_on, d.verdict)
 }

@@ -4,12 +4,20 @@ use anyhow::{bail, Result};
 use std::path::{Path, PathBuf};
 use stiction_core::reproduce::{reproduce_paper, PaperCase, PaperReproduction, PaperSetup};
 
+/// What `reproduce` can reproduce.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum Target {
+    /// The ACO stiction paper's open-loop cases (Table 2 and Figs 5-8)
+    Paper,
+}
+
 #[derive(clap::Args)]
 #[command(after_help = "Example:
   stiction reproduce paper --out out/paper")]
 pub struct Args {
-    /// What to reproduce: paper (the ACO stiction paper's open-loop cases, Table 2 and Figs 5-8)
-    what: String,
+    /// What to reproduce
+    #[arg(value_enum)]
+    what: Target,
     /// Folder for the figures (PNG and SVG) and results.json
     #[arg(long, default_value = "out/paper")]
     out: PathBuf,
@@ -22,12 +30,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<()> {
-    if a.what != "paper" {
-        bail!(
-            "reproduce: unknown target '{}'; the one target is 'paper'",
-            a.what
-        );
-    }
+    let Target::Paper = a.what;
     if a.seeds == 0 {
         bail!("--seeds must be at least 1");
     }

@@ -7,6 +7,15 @@ use std::path::{Path, PathBuf};
 use stiction_core::sim::{simulate_open_loop, ClosedLoop, LoopData, Signal};
 use stiction_core::sim_check::{loop_health, LoopHealth, Stability, SATURATION_LIMIT};
 
+/// How the valve is driven.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum LoopKind {
+    /// A command signal drives the valve
+    Open,
+    /// A PI controller drives it in a loop
+    Closed,
+}
+
 #[derive(clap::Args)]
 #[command(after_help = "Examples:
   stiction simulate --model stenman --param d=0.5 -o open.csv
@@ -15,8 +24,8 @@ use stiction_core::sim_check::{loop_health, LoopHealth, Stability, SATURATION_LI
       --pi Kc=0.2,Ti=10 --ts 1 --samples 2000 --noise 0.05 --seed 7 -o loop.csv")]
 pub struct Args {
     /// open: a command signal drives the valve; closed: a PI controller drives it in a loop
-    #[arg(long = "loop", default_value = "open", value_parser = ["open", "closed"])]
-    loop_kind: String,
+    #[arg(long = "loop", value_enum, default_value_t = LoopKind::Open)]
+    loop_kind: LoopKind,
     /// Stiction model: stenman, he, kano, choudhury
     #[arg(long, default_value = "stenman")]
     model: String,
@@ -65,7 +74,7 @@ pub struct Args {
 pub fn run(a: Args) -> Result<()> {
     let kind = spec::model_kind(&a.model)?;
     let model = spec::model(kind, &a.params)?;
-    let closed = a.loop_kind == "closed";
+    let closed = a.loop_kind == LoopKind::Closed;
     let ts = a.ts.unwrap_or(if closed { 1.0 } else { 0.1 });
     let samples = a.samples.unwrap_or(if closed { 2000 } else { 1001 });
     if !(ts > 0.0 && ts.is_finite()) {
@@ -110,7 +119,10 @@ pub fn run(a: Args) -> Result<()> {
     let samples_text = count(samples, "sample", "samples");
     eprintln!(
         "wrote {samples_text} ({} loop, {} {}) to {}",
-        a.loop_kind,
+        match a.loop_kind {
+            LoopKind::Open => "open",
+            LoopKind::Closed => "closed",
+        },
         kind,
         kind.param_names()
             .iter()

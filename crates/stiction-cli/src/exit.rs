@@ -4,6 +4,7 @@
 
 use std::fmt;
 use std::process::ExitCode;
+use stiction_core::diagnose::Verdict;
 
 /// What the program's exit status means.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -73,4 +74,24 @@ pub fn report(e: &anyhow::Error) -> (Exit, Option<String>) {
     }
     let msg: Vec<String> = e.chain().map(|c| c.to_string()).collect();
     (Exit::BadInput, Some(format!("error: {}", msg.join(": "))))
+}
+
+/// Verdicts a script can gate on with `--fail-on`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FailOn {
+    /// The verdict is stiction (exit code 4)
+    Stiction,
+}
+
+impl FailOn {
+    /// The ending for `--fail-on` when the verdict calls for it.
+    pub fn check(fail_on: Option<FailOn>, verdict: Verdict) -> anyhow::Result<()> {
+        match fail_on {
+            Some(FailOn::Stiction) if verdict == Verdict::Stiction => Err(Ending::error(
+                Exit::StictionFound,
+                "stiction found (--fail-on stiction: exit code 4)",
+            )),
+            _ => Ok(()),
+        }
+    }
 }

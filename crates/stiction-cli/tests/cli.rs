@@ -443,7 +443,7 @@ fn bad_bounds_and_names() {
         ],
         &["tau", "> 0"],
     );
-    fails(&["reproduce", "everything"], &["unknown target", "paper"]);
+    fails(&["reproduce", "everything"], &["everything", "paper"]);
 }
 
 // ----------------------------------------------------------------------------- quantify

@@ -5,7 +5,7 @@
 use super::inputs::{Inputs, Source, WideLoop};
 use super::layout::{Layout, LoopList, LoopSpec, TagPattern};
 use super::long::LongFile;
-use crate::cmd_diagnose::Columns;
+use crate::loop_file::Columns;
 use anyhow::{bail, Result};
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};

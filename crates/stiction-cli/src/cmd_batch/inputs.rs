@@ -6,8 +6,8 @@
 use super::layout::{LoopList, LoopSpec};
 use super::long::{stream_long, LongFile};
 use super::stop::Stop;
-use crate::cmd_diagnose::Columns;
 use crate::data::Table;
+use crate::loop_file::Columns;
 use anyhow::{bail, Context, Result};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};

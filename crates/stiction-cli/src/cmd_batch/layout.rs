@@ -3,7 +3,7 @@
 //! columns and options), or a tag pattern that splits the columns of wide exports into loops
 //! (`--tags '{loop}.{role}'`: `FIC101.OP, FIC101.PV, LIC7.OP, ...`).
 
-use crate::cmd_diagnose::Columns;
+use crate::loop_file::Columns;
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 use std::collections::BTreeMap;

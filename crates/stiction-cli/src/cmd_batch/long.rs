@@ -6,7 +6,7 @@
 
 use super::inputs::{JobData, Out};
 use super::layout::{LoopList, LoopSpec};
-use crate::cmd_diagnose::Columns;
+use crate::loop_file::Columns;
 use std::collections::HashSet;
 use std::io::{BufRead, BufReader};
 use std::path::PathBuf;

@@ -3,7 +3,7 @@
 //! it was diagnosed with. A loop is kept only when both are unchanged; otherwise it is diagnosed
 //! again.
 
-use crate::cmd_diagnose::Columns;
+use crate::loop_file::Columns;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use stiction_core::diagnose::Diagnosis;

@@ -11,7 +11,7 @@ use crate::words::{capital, duration, num, verdict};
 use anyhow::Result;
 use serde::Serialize;
 use stiction_core::diagnose::Diagnosis;
-use stiction_core::quantify::Quantification;
+use stiction_core::quantify::{Quantification, QuantifyStatus};
 
 /// Text with a little markup: plain runs, `code` runs and `strong` runs.
 #[derive(Serialize, Default)]
@@ -123,7 +123,10 @@ const PHASE_POINTS: usize = 6000;
 const EVERY_SAMPLE: usize = 1 << 20;
 
 pub fn build(loop_id: &str, lf: &LoopFile, d: &Diagnosis, o: &PageOptions) -> Result<Report> {
-    let q = d.quantification.as_ref().filter(|q| q.status == "ok");
+    let q = d
+        .quantification
+        .as_ref()
+        .filter(|q| q.status == QuantifyStatus::Ok);
     let zoom = if lf.op.len() > LONG_RECORD {
         Some(zoom(lf, d, q)?)
     } else {

@@ -5,7 +5,10 @@ use super::context::{rich, Rich};
 use crate::words::{self, capital, duration, num, opt, verdict};
 use serde::Serialize;
 use stiction_core::diagnose::{BandSource, Diagnosis, Verdict, Vote};
-use stiction_core::quantify::Quantification;
+use stiction_core::estimate::IntervalKind;
+use stiction_core::quantify::{
+    FitOutput, LinearFamily, Quantification, QuantifyStatus, ValveStartKind,
+};
 
 /// A row of a two-column table: a label and its value.
 #[derive(Serialize)]
@@ -186,7 +189,7 @@ fn band_value(d: &Diagnosis) -> Rich {
         return r;
     }
     match d.quantification.as_ref() {
-        Some(q) if q.status != "ok" => rich(format!(
+        Some(q) if q.status != QuantifyStatus::Ok => rich(format!(
             "not estimated: {}",
             q.reason.as_deref().unwrap_or("insufficient data")
         )),
@@ -200,13 +203,13 @@ fn band_value(d: &Diagnosis) -> Rich {
 
 fn model_rows(q: &Quantification) -> Option<Vec<KvRow>> {
     let lm = q.linear_model.as_ref()?;
-    let gain = match (lm.gain, lm.family.as_str()) {
-        (Some(g), "integrating") => format!("{} per s (integration rate)", num(g)),
+    let gain = match (lm.gain, lm.family) {
+        (Some(g), LinearFamily::Integrating) => format!("{} per s (integration rate)", num(g)),
         (Some(g), _) => num(g),
         (None, _) => "–".into(),
     };
     let mut rows = vec![
-        kv("Family", lm.family.replace('_', "-")),
+        kv("Family", lm.family.to_string()),
         kv("Orders", format!("na = {}, nb = {} (ARX)", lm.na, lm.nb)),
         kv(
             "Delay",
@@ -223,7 +226,7 @@ fn model_rows(q: &Quantification) -> Option<Vec<KvRow>> {
         kv("Dead time", duration(lm.dead_time)),
     ];
     if let Some(f) = &q.fit {
-        let what = if f.output == "pv" {
+        let what = if f.output == FitOutput::Pv {
             "PV"
         } else {
             "the change of PV per sample"
@@ -267,9 +270,11 @@ pub fn estimates(d: &Diagnosis, q: Option<&Quantification>) -> Estimates {
     }
     if let Some(x0) = q.and_then(|q| q.valve_start) {
         let value = rich(format!("{}, ", num(x0)));
-        let value = match q.and_then(|q| q.valve_start_kind.as_deref()) {
-            Some("estimated") => value.text("estimated (").code("--estimate-start").text(")"),
-            Some("given") => value.text("given"),
+        let value = match q.and_then(|q| q.valve_start_kind) {
+            Some(ValveStartKind::Estimated) => {
+                value.text("estimated (").code("--estimate-start").text(")")
+            }
+            Some(ValveStartKind::Given) => value.text("given"),
             _ => value
                 .text("assumed at the first OP (")
                 .code("--estimate-start")
@@ -279,8 +284,13 @@ pub fn estimates(d: &Diagnosis, q: Option<&Quantification>) -> Estimates {
     }
     Estimates {
         rows,
-        exact_set: q
-            .is_some_and(|q| !q.interval.is_empty() && q.interval_kind.starts_with("exact")),
+        exact_set: q.is_some_and(|q| {
+            !q.interval.is_empty()
+                && matches!(
+                    q.interval_kind,
+                    IntervalKind::Exact | IntervalKind::ExactLocal | IntervalKind::ExactStaged
+                )
+        }),
         model: q.and_then(model_rows),
     }
 }
@@ -302,14 +312,14 @@ pub fn convergence(q: &Quantification) -> Convergence {
         kv("Time", duration(q.seconds)),
         kv("Samples", format!("{} at {} s", q.samples, num(q.ts))),
     ];
-    let why = match q.interval_kind.as_str() {
-        "exact" => {
+    let why = match q.interval_kind {
+        IntervalKind::Exact => {
             "The exact method does not search: the band d changes the estimated valve \
              trajectory only at a finite set of values, so the whole range of d splits into \
              cells with one valve trajectory each; every cell was fitted once. The optimum \
              is proven over every distinct valve trajectory, not found by chance."
         }
-        "exact_staged" => {
+        IntervalKind::ExactStaged => {
             "The exact method does not search: the band d changes the estimated valve \
              trajectory only at a finite set of values, so the whole range of d splits into \
              cells with one valve trajectory each. Every cell of the first samples was fitted, \
@@ -317,11 +327,13 @@ pub fn convergence(q: &Quantification) -> Convergence {
              whole record lies inside one cell of its first samples). The optimum is proven \
              over every distinct valve trajectory kept, not found by chance."
         }
-        "exact_local" => {
+        IntervalKind::ExactLocal => {
             "The exact method fitted every valve trajectory near the best points of a \
              coarse scan: the optimum is proven there only."
         }
-        _ => "A search method: the optimum is the best point found, not proven.",
+        IntervalKind::Grid | IntervalKind::Axis | IntervalKind::None => {
+            "A search method: the optimum is the best point found, not proven."
+        }
     };
     Convergence { rows, why }
 }

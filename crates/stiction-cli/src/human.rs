@@ -1,0 +1,179 @@
+//! The human output of `diagnose`: the verdict, the band, the fits and each family's vote, the
+//! record, its oscillation and its quality, one line each.
+
+use crate::words::{count, seconds};
+use stiction_core::diagnose::{BandSource, Diagnosis, Verdict, Vote};
+
+fn band_source(s: BandSource) -> &'static str {
+    match s {
+        BandSource::Valve => "from the recorded valve position",
+        BandSource::ClosedLoop => "closed-loop estimate, Stenman exact",
+        BandSource::FitScan => "closed-loop fit's scan",
+        BandSource::StickSlip => "median OP travel per stick",
+        BandSource::DescribingFunction => "describing function of the limit cycle",
+    }
+}
+
+/// Print the diagnosis of `file` for a person.
+pub fn print_diagnosis(file: &str, d: &Diagnosis) {
+    headline(file, d);
+    fits(d);
+    println!("  next step: {}", d.next_step);
+    evidence(d);
+    record(d);
+    for w in &d.warnings {
+        println!("  note: {w}");
+    }
+}
+
+/// The verdict, its reason and the band.
+fn headline(file: &str, d: &Diagnosis) {
+    let verdict = match d.verdict {
+        Verdict::Stiction => "STICTION",
+        v => crate::words::verdict(v),
+    };
+    match d.confidence {
+        Some(c) => println!("{file}: {verdict} (confidence {c:.2})"),
+        None => println!("{file}: {verdict}"),
+    }
+    if let Some(r) = &d.reason {
+        println!("  reason: {r}");
+    }
+    if let Some(b) = &d.band {
+        let interval = b
+            .interval_percent_of_span
+            .map(|[lo, hi]| format!(", optimal set {lo:.2} to {hi:.2} %"))
+            .unwrap_or_default();
+        let mut others: Vec<String> = b
+            .others
+            .iter()
+            .map(|(s, v)| format!("{} {v:.2} %", band_source(*s)))
+            .collect();
+        if let Some(e) = b.ellipse_percent_of_span {
+            others.push(format!("ellipse {e:.2} %"));
+        }
+        println!(
+            "  stiction band: {:.2} % of valve span ({}{interval}){}",
+            b.band_percent_of_span,
+            band_source(b.source),
+            if others.is_empty() {
+                String::new()
+            } else {
+                format!("; beside it: {}", others.join(", "))
+            }
+        );
+    }
+}
+
+/// The closed-loop fits and the linear loop's balance.
+fn fits(d: &Diagnosis) {
+    if let Some(m) = d.families.iter().find_map(|f| f.model.as_ref()) {
+        println!(
+            "  closed-loop fit: R² {:.3} without stiction, {:.3} with (Stenman), {:.3} with a slip jump (Kano)",
+            m.r2_without_stiction, m.r2_stenman, m.r2_slip_jump
+        );
+    }
+    if let Some(l) = d.families.iter().find_map(|f| f.limit_cycle.as_ref()) {
+        println!(
+            "  linear loop: gain margin {}; to sustain the {:.0} s cycle the valve must lag OP by {:.0}° (gain {:.2}){}",
+            l.margins
+                .gain_margin
+                .map_or("none".into(), |g| format!("{g:.2}")),
+            l.period,
+            l.needed_lag_degrees,
+            l.needed_gain,
+            l.describing.as_ref().map_or(String::new(), |b| format!(
+                "; describing function: a band of {:.2} % of span{}",
+                b.band_percent_of_span,
+                b.predicted_period
+                    .map_or(String::new(), |p| format!(", predicted period {p:.0} s"))
+            ))
+        );
+    }
+}
+
+/// Each family's vote, then the shape indices.
+fn evidence(d: &Diagnosis) {
+    println!("  evidence:");
+    for f in &d.families {
+        println!(
+            "    {:<21} {:<13} {}",
+            f.family.words(),
+            crate::words::vote(f.vote),
+            f.note
+        );
+    }
+    if !d.indices.is_empty() {
+        println!("  shape indices (oscillating stretch):");
+        for i in &d.indices {
+            println!(
+                "    {:<18} {:>8}  {:<13} {}{}",
+                i.name,
+                i.value.map_or("-".into(), |v| format!("{v:.3}")),
+                crate::words::vote(i.vote),
+                i.threshold,
+                if i.weight == 0.0 {
+                    " [shown, not counted]"
+                } else if i.only_votes.is_some() && i.vote == Vote::Undetermined {
+                    " [one-sided: silent]"
+                } else {
+                    ""
+                }
+            );
+        }
+    }
+}
+
+/// The record: samples, oscillation, data quality and the windows.
+fn record(d: &Diagnosis) {
+    println!(
+        "  {} at {} s; analysed samples {} to {} ({})",
+        count(d.samples, "sample", "samples"),
+        seconds(d.ts),
+        d.analysed[0],
+        d.analysed[1],
+        count(d.stretches.len(), "usable stretch", "usable stretches")
+    );
+    if let Some(o) = &d.oscillation {
+        println!(
+            "  oscillation: {}; period {}; regularity {:.2} (threshold {}); {} half periods with a large IAE",
+            if o.oscillating { "yes" } else { "no" },
+            o.period.map_or("-".into(), |p| format!("{p:.1} s")),
+            o.regularity.regularity,
+            o.regularity.threshold,
+            o.iae.exceedances
+        );
+    }
+    let failed: Vec<_> = d.quality.iter().filter(|f| !f.passed).collect();
+    if failed.is_empty() {
+        println!(
+            "  data quality: every check passed ({} made)",
+            d.quality.len()
+        );
+    } else {
+        for f in failed {
+            println!("  data quality, {}: {}", f.gate, f.message);
+        }
+    }
+    if d.windows.is_empty() {
+        return;
+    }
+    println!("  windows:");
+    for w in &d.windows {
+        println!(
+            "    samples {:>7} to {:>7} (t {:.0} to {:.0} s): {}{}{}",
+            w.start,
+            w.end,
+            w.t_start,
+            w.t_end,
+            w.verdict,
+            w.confidence
+                .map(|c| format!(" ({c:.2})"))
+                .unwrap_or_default(),
+            w.reason
+                .as_deref()
+                .map(|r| format!(": {r}"))
+                .unwrap_or_default()
+        );
+    }
+}
