@@ -97,7 +97,7 @@ fn evidence(d: &Diagnosis) {
     println!("  evidence:");
     for f in &d.families {
         println!(
-            "    {:<21} {:<13} {}",
+            "    {:<24} {:<13} {}",
             f.family.words(),
             crate::words::vote(f.vote),
             f.note

@@ -155,7 +155,15 @@ fn main() -> ExitCode {
             what.replace('\n', " ")
         );
     }));
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // --help and --version print to standard output and end with 0
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            eprintln!("{}", clap_error_line(&e));
+            return Exit::BadInput.code();
+        }
+    };
     match std::panic::catch_unwind(|| run(cli.command)) {
         Ok(Ok(())) => Exit::Ok.code(),
         Ok(Err(e)) => {
@@ -167,4 +175,18 @@ fn main() -> ExitCode {
         }
         Err(_) => Exit::Internal.code(),
     }
+}
+
+/// A flag or value clap rejects, in one line: its message and the possible values, without the
+/// usage block.
+fn clap_error_line(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let parts: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| {
+            !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information")
+        })
+        .collect();
+    format!("{} (see --help)", parts.join(" "))
 }

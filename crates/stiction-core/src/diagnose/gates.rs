@@ -6,7 +6,8 @@ use super::request::DiagnoseRequest;
 use super::stretch::Excluded;
 use crate::quality::{self, Finding, Record};
 
-fn plural(n: usize, one: &str, many: &str) -> String {
+/// `n` and the noun's singular or plural form: "1 gap", "3 gaps".
+pub(crate) fn plural(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 

@@ -14,6 +14,7 @@
 //! - the ending PV move must go the way OP pushed (through the process gain's sign).
 
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
+use crate::diagnose::gates::plural;
 use crate::diagnose::oscillation::{percentile, smooth};
 use crate::diagnose::result::Vote;
 use serde::{Deserialize, Serialize};
@@ -301,8 +302,9 @@ impl EvidenceFamily for StickSlip {
                 Vote::NoStiction,
                 0.25,
                 format!(
-                    "{} stick-slip episodes in {} stretches of quiet PV: PV follows OP",
-                    e.episodes, e.quiet_stretches
+                    "{} in {} of quiet PV: PV follows OP",
+                    plural(e.episodes, "stick-slip episode", "stick-slip episodes"),
+                    plural(e.quiet_stretches, "stretch", "stretches")
                 ),
             )
         } else {
@@ -310,10 +312,10 @@ impl EvidenceFamily for StickSlip {
                 Vote::Undetermined,
                 0.0,
                 format!(
-                    "{} episodes ({:.0} % of the OP's travel) in {} quiet stretches: too few to decide",
-                    e.episodes,
+                    "{} ({:.0} % of the OP's travel) in {}: too few to decide",
+                    plural(e.episodes, "episode", "episodes"),
                     100.0 * e.stuck_share,
-                    e.quiet_stretches
+                    plural(e.quiet_stretches, "quiet stretch", "quiet stretches")
                 ),
             )
         };
