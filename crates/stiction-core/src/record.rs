@@ -136,9 +136,14 @@ pub fn prepare<'a>(mut s: Signals<'a>, ts: Option<f64>) -> Result<Prepared<'a>, 
 
 /// A row without its time is a gap in op, pv, sp and mv.
 fn gaps_where_time_is_missing(s: &mut Signals, missing: &[usize]) {
-    for v in [Some(&mut s.op), Some(&mut s.pv), s.sp.as_mut(), s.mv.as_mut()]
-        .into_iter()
-        .flatten()
+    for v in [
+        Some(&mut s.op),
+        Some(&mut s.pv),
+        s.sp.as_mut(),
+        s.mv.as_mut(),
+    ]
+    .into_iter()
+    .flatten()
     {
         let v = v.to_mut();
         for &k in missing {

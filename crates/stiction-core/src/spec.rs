@@ -43,7 +43,10 @@ pub fn pairs(text: &str, what: &str, known: &[&str]) -> Result<Vec<(String, f64)
             .ok()
             .filter(|v: &f64| v.is_finite())
             .ok_or_else(|| {
-                SpecError(format!("{what}: {name} = '{}' is not a finite number", value.trim()))
+                SpecError(format!(
+                    "{what}: {name} = '{}' is not a finite number",
+                    value.trim()
+                ))
             })?;
         if out.iter().any(|(n, _)| n == canonical) {
             bail!("{what}: {name} is given twice");
@@ -104,7 +107,8 @@ pub fn signal(text: &str, flag: &str) -> Result<Signal, SpecError> {
             "{flag}: unknown signal '{other}'; the signals are sine, triangle, random-walk, steps, step, const (e.g. {flag} sine:amplitude=1,period=10)"
         ),
     };
-    s.validate().map_err(|e| SpecError(format!("{what}: {e}")))?;
+    s.validate()
+        .map_err(|e| SpecError(format!("{what}: {e}")))?;
     Ok(s)
 }
 
@@ -131,7 +135,8 @@ pub fn process(text: &str, flag: &str) -> Result<Process, SpecError> {
         }
         other => bail!("{flag}: unknown process '{other}'; use foptd:K=3,tau=10,delay=10 or integrating:K=0.02,delay=2"),
     };
-    p.validate().map_err(|e| SpecError(format!("{what}: {e}")))?;
+    p.validate()
+        .map_err(|e| SpecError(format!("{what}: {e}")))?;
     Ok(p)
 }
 
@@ -143,7 +148,6 @@ pub fn pi(text: &str, flag: &str) -> Result<Pi, SpecError> {
         ti: get(&p, "Ti", 10.0),
     })
 }
-
 
 /// A model of `kind` from `NAME=VALUE` texts (each may hold several, comma-separated), every
 /// parameter named once; `flag` names where they came from (`--param`, `params=`).

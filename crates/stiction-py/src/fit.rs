@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::borrow::Cow;
 use std::collections::HashMap;
-use stiction_core::estimate::{self, Method, Request};
+use stiction_core::estimate::{self as core_estimate, Method, Request};
 use stiction_core::models::ModelKind;
 use stiction_core::quantify::{self as core_quantify, QuantifyRequest};
 use stiction_core::record::{self, longest_clean, PrepareError, Signals};
@@ -155,9 +155,11 @@ pub fn quantify(
         req.acor.iterations = n;
     }
     if let Some(given) = bounds.filter(|b| !b.is_empty()) {
-        let (lo, hi) = op.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-            (l.min(v), h.max(v))
-        });
+        let (lo, hi) = op
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                (l.min(v), h.max(v))
+            });
         let range = (0.0, (hi - lo).max(f64::MIN_POSITIVE));
         req.bounds = Some(self::bounds(kind, given, vec![range; kind.dim()])?);
     }
@@ -238,18 +240,20 @@ pub fn estimate(
             mv.len()
         )));
     }
-    let (s, e, note) = fit_stretch(("op", &op), ("mv", &mv), estimate::MIN_SAMPLES)?;
+    let (s, e, note) = fit_stretch(("op", &op), ("mv", &mv), core_estimate::MIN_SAMPLES)?;
     let (op, mv) = (&op[s..e], &mv[s..e]);
-    let (lo, hi) = op.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-        (l.min(v), h.max(v))
-    });
+    let (lo, hi) = op
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
     if hi - lo <= 0.0 {
         return Err(bad(format!(
             "op (controller output op) is constant at {lo}; a valve whose command never moves shows no stiction, choose a stretch of data where op varies"
         )));
     }
     let est = py
-        .detach(|| estimate::estimate(op, mv, &req))
+        .detach(|| core_estimate::estimate(op, mv, &req))
         .map_err(|e| bad(e.to_string()))?;
     Ok((json(&est)?, note.into_iter().collect()))
 }

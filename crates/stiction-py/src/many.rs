@@ -74,9 +74,8 @@ impl Progress {
 
 /// One loop's row; never panics through (a bug in one loop is that loop's failure).
 fn row(fleet: &Fleet, id: &str, source: &str, (a, b): (usize, usize), s: &Settings) -> Row {
-    let done = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        run(fleet.signals(a, b), s)
-    }));
+    let done =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(fleet.signals(a, b), s)));
     match done {
         Ok(Ok((d, _))) => Row::from_diagnosis(id, source, &d),
         Ok(Err(why)) => Row::failed(id, source, format!("{source}: {why}")),
@@ -175,7 +174,13 @@ pub fn diagnose_many(
                     let r = match failed.get(&i) {
                         // a cell the front end could not read fails its loop only
                         Some(why) => Row::failed(&ids[i], &sources[i], why.clone()),
-                        None => row(&fleet, &ids[i], &sources[i], (starts[i], starts[i + 1]), &settings),
+                        None => row(
+                            &fleet,
+                            &ids[i],
+                            &sources[i],
+                            (starts[i], starts[i + 1]),
+                            &settings,
+                        ),
                     };
                     progress.tick();
                     r

@@ -15,8 +15,11 @@ def run_json(cli, *args):
 
 
 def without_seconds(d):
-    d = dict(d)
-    d.pop("seconds", None)
+    """The result without the times the runs took (`seconds`, at any depth)."""
+    if isinstance(d, dict):
+        return {k: without_seconds(v) for k, v in d.items() if k != "seconds"}
+    if isinstance(d, list):
+        return [without_seconds(v) for v in d]
     return d
 
 

@@ -67,7 +67,7 @@ def test_errors_name_the_column_and_the_fix(loop):
         stiction.diagnose(df)
     with pytest.raises(ValueError, match=r"window=50: a window needs at least 200 samples"):
         stiction.diagnose(loop, window=50)
-    with pytest.raises(ValueError, match=r"ts=-1.0: the sampling time must be a positive number"):
+    with pytest.raises(ValueError, match=r"ts=-1: the sampling time must be a positive number"):
         stiction.diagnose(loop, ts=-1.0)
     with pytest.raises(ValueError, match=r"pv has 10 samples but op has 20"):
         stiction.diagnose(op=np.zeros(20), pv=np.zeros(10))

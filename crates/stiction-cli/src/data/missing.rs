@@ -7,8 +7,8 @@ pub use stiction_core::record::is_missing;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use stiction_core::record::longest_clean;
     use proptest::prelude::*;
+    use stiction_core::record::longest_clean;
 
     #[test]
     fn historian_states_are_missing() {

@@ -94,9 +94,11 @@ def seconds(values: Any, name: str) -> np.ndarray:
         values = pd.Series(values)
     if isinstance(values, pd.DatetimeIndex):
         idx = values.tz_convert("UTC").tz_localize(None) if values.tz is not None else values
-        ns = idx.asi8.astype(np.float64)
-        ns[np.asarray(idx.isna())] = np.nan
-        return ns / 1e9
+        # nanoseconds whatever the index's unit (pandas 3 makes microsecond indexes)
+        ns = np.asarray(idx, dtype="datetime64[ns]")
+        out = ns.astype(np.int64).astype(np.float64) / 1e9
+        out[np.isnat(ns)] = np.nan
+        return out
     s = values if isinstance(values, pd.Series) else pd.Series(np.asarray(values))
     if pd.api.types.is_datetime64_any_dtype(s.dtype):
         return seconds(pd.DatetimeIndex(s), name)
