@@ -5,9 +5,11 @@
 
 use crate::data::{self, ReadOptions, Table, TimeFormat, TimeSpec};
 use crate::words::count;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
+use std::borrow::Cow;
 use std::path::Path;
 use stiction_core::diagnose::{DiagnoseRequest, LoopRecord};
+use stiction_core::record::{self, PrepareError};
 
 /// How to read a data file beyond its columns: the sheet of a workbook, the form and the zone
 /// of its times.
@@ -254,13 +256,13 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
         }
         Ok(v)
     };
-    let mut op = column(s.op, "--op", "controller output op")?;
-    let mut pv = column(s.pv, "--pv", "process variable pv")?;
-    let mut sp = s.sp.map(|c| column(c, "--sp", "setpoint sp")).transpose()?;
-    let mut mv =
+    let op = column(s.op, "--op", "controller output op")?;
+    let pv = column(s.pv, "--pv", "process variable pv")?;
+    let sp = s.sp.map(|c| column(c, "--sp", "setpoint sp")).transpose()?;
+    let mv =
         s.mv.map(|c| column(c, "--mv", "valve position mv"))
             .transpose()?;
-    let mut auto = match s.mode {
+    let auto = match s.mode {
         Some(c) => {
             let col = table.require(c, "--mode", "controller mode")?;
             let k = table.missing(col);
@@ -273,7 +275,7 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
     };
     let mut notes = Vec::new();
     let time_col = data::time_column(table, s.time)?;
-    let mut time = match time_col {
+    let time = match time_col {
         Some(c) => {
             let axis = table.time_axis(c, spec)?;
             notes.extend(axis.notes);
@@ -284,141 +286,37 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
         }
         None => None,
     };
-    if let Some(t) = &mut time {
-        // a row without its time is a gap; its time is filled in so the axis stays whole
-        for k in 0..t.len() {
-            if t[k].is_nan() {
-                op[k] = f64::NAN;
-                pv[k] = f64::NAN;
-                if let Some(sp) = &mut sp {
-                    sp[k] = f64::NAN;
-                }
-                if let Some(mv) = &mut mv {
-                    mv[k] = f64::NAN;
-                }
-            }
-        }
-        if !fill_times(t) {
-            notes.push("the time column has no values; it is left out".into());
-            time = None;
-        }
-    }
-    let mut rows = None;
-    if let Some(t) = &time {
-        if let Some((keep, note)) = time_order(t) {
-            notes.push(note);
-            let pick = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
-            op = pick(&op);
-            pv = pick(&pv);
-            sp = sp.as_deref().map(pick);
-            mv = mv.as_deref().map(pick);
-            auto = auto.map(|a| keep.iter().map(|&k| a[k]).collect());
-            time = Some(pick(t));
-            rows = Some(keep);
-        }
-    }
-    let ts = match (s.ts, &time) {
-        (Some(ts), _) => ts,
-        (None, Some(t)) => data::sampling_time(t).with_context(|| {
-            format!(
-                "{file}: the time column '{}' does not increase; give the sampling time with --ts SECONDS",
-                table.headers[time_col.unwrap_or(0)]
-            )
-        })?,
-        (None, None) => 1.0,
+    // gaps in time, time order and the sampling time: the core's preparation, shared with Python
+    let signals = record::Signals {
+        op: Cow::Owned(op),
+        pv: Cow::Owned(pv),
+        sp: sp.map(Cow::Owned),
+        mv: mv.map(Cow::Owned),
+        auto: auto.map(Cow::Owned),
+        time: time.map(Cow::Owned),
     };
+    let p = record::prepare(signals, s.ts).map_err(|e| match e {
+        PrepareError::Ts(ts) => {
+            anyhow::anyhow!("--ts {ts}: the sampling time must be a positive number of seconds")
+        }
+        PrepareError::TimeNotIncreasing => anyhow::anyhow!(
+            "{file}: the time column '{}' does not increase; give the sampling time with --ts SECONDS",
+            table.headers[time_col.unwrap_or(0)]
+        ),
+        e => anyhow::anyhow!("{file}: {e}"),
+    })?;
+    notes.extend(p.notes);
+    let v = p.signals;
     Ok(LoopFile {
-        op,
-        pv,
-        sp,
-        mv,
-        time,
-        auto,
-        ts,
+        op: v.op.into_owned(),
+        pv: v.pv.into_owned(),
+        sp: v.sp.map(Cow::into_owned),
+        mv: v.mv.map(Cow::into_owned),
+        time: v.time.map(Cow::into_owned),
+        auto: v.auto.map(Cow::into_owned),
+        ts: p.ts,
         missing,
         notes,
-        rows,
+        rows: p.rows,
     })
-}
-
-/// Fill NaN times by straight lines between their neighbours (by the median step past the
-/// ends). False when no time is known.
-fn fill_times(t: &mut [f64]) -> bool {
-    let known: Vec<usize> = (0..t.len()).filter(|&k| t[k].is_finite()).collect();
-    let (Some(&first), Some(&last)) = (known.first(), known.last()) else {
-        return false;
-    };
-    // the median step per sample between known times (neighbours or not)
-    let mut steps: Vec<f64> = known
-        .windows(2)
-        .map(|w| (t[w[1]] - t[w[0]]) / (w[1] - w[0]) as f64)
-        .collect();
-    steps.sort_by(f64::total_cmp);
-    let step = steps.get(steps.len() / 2).copied().unwrap_or(1.0);
-    for k in 0..first {
-        t[k] = t[first] - (first - k) as f64 * step;
-    }
-    for k in last + 1..t.len() {
-        t[k] = t[last] + (k - last) as f64 * step;
-    }
-    for w in known.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        for k in a + 1..b {
-            t[k] = t[a] + (t[b] - t[a]) * (k - a) as f64 / (b - a) as f64;
-        }
-    }
-    true
-}
-
-/// The rows to keep, in time order, when the file is not in time order or repeats a time
-/// (the first row of each time kept), with a note; `None` when time only increases.
-fn time_order(t: &[f64]) -> Option<(Vec<usize>, String)> {
-    if t.windows(2).all(|w| w[1] > w[0]) {
-        return None;
-    }
-    let backwards = t.windows(2).filter(|w| w[1] < w[0]).count();
-    let mut keep: Vec<usize> = (0..t.len()).collect();
-    keep.sort_by(|&a, &b| t[a].total_cmp(&t[b]).then(a.cmp(&b)));
-    let before = keep.len();
-    keep.dedup_by(|b, a| t[*a] == t[*b]);
-    let repeats = before - keep.len();
-    let mut said = Vec::new();
-    if backwards > 0 {
-        said.push(format!(
-            "the rows are not in time order ({} back): sorted by time",
-            count(backwards, "step goes", "steps go")
-        ));
-    }
-    if repeats > 0 {
-        said.push(format!(
-            "{} an earlier row's time: the first row of each time is kept",
-            count(repeats, "row repeats", "rows repeat")
-        ));
-    }
-    Some((keep, said.join("; ")))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn missing_times_are_filled_between_neighbours() {
-        let nan = f64::NAN;
-        let mut t = [nan, 1.0, nan, nan, 4.0, nan];
-        assert!(fill_times(&mut t));
-        assert_eq!(t, [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
-        assert!(!fill_times(&mut [nan, nan]));
-    }
-
-    #[test]
-    fn rows_are_sorted_and_repeats_dropped() {
-        assert!(time_order(&[0.0, 1.0, 2.0]).is_none());
-        let (keep, note) = time_order(&[0.0, 2.0, 1.0, 2.0, 3.0]).unwrap();
-        assert_eq!(keep, vec![0, 2, 1, 4]);
-        assert!(
-            note.contains("1 step goes back") && note.contains("1 row repeats"),
-            "{note}"
-        );
-    }
 }

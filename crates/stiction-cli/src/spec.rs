@@ -4,132 +4,21 @@
 use anyhow::{bail, Context, Result};
 use stiction_core::models::{Model, ModelKind};
 use stiction_core::sim::{Pi, Process, Signal};
+use stiction_core::spec as core_spec;
 
-/// `a=1,b=2` (also `a=1 b=2`) into pairs, checking every name against `known` (case-insensitive).
-pub fn pairs(text: &str, what: &str, known: &[&str]) -> Result<Vec<(String, f64)>> {
-    let mut out: Vec<(String, f64)> = Vec::new();
-    for item in text.split([',', ' ']).filter(|s| !s.trim().is_empty()) {
-        let Some((name, value)) = item.split_once('=') else {
-            bail!(
-                "{what}: '{item}' is not NAME=VALUE; write e.g. {}=1",
-                known.first().unwrap_or(&"x")
-            )
-        };
-        let name = name.trim();
-        let canonical = known
-            .iter()
-            .find(|k| k.eq_ignore_ascii_case(name))
-            .with_context(|| {
-                format!(
-                    "{what}: unknown name '{name}'; the names are {}",
-                    known.join(", ")
-                )
-            })?;
-        let value: f64 = value
-            .trim()
-            .parse()
-            .ok()
-            .filter(|v: &f64| v.is_finite())
-            .with_context(|| {
-                format!("{what}: {name} = '{}' is not a finite number", value.trim())
-            })?;
-        if out.iter().any(|(n, _)| n == canonical) {
-            bail!("{what}: {name} is given twice");
-        }
-        out.push((canonical.to_string(), value));
-    }
-    Ok(out)
-}
-
-fn get(p: &[(String, f64)], name: &str, default: f64) -> f64 {
-    p.iter()
-        .find(|(n, _)| n == name)
-        .map_or(default, |(_, v)| *v)
-}
-
-/// `KIND:k=v,...` into a signal. Unnamed settings take the defaults shown in `--help`.
+/// `KIND:k=v,...` into a signal (the core's reading, shared with Python).
 pub fn signal(text: &str, flag: &str) -> Result<Signal> {
-    let (kind, rest) = text.split_once(':').unwrap_or((text, ""));
-    let what = format!("{flag} {text}");
-    let kind = kind.trim().to_ascii_lowercase();
-    let s = match kind.as_str() {
-        "sine" | "triangle" => {
-            let p = pairs(rest, &what, &["amplitude", "period", "offset"])?;
-            let (amplitude, period, offset) =
-                (get(&p, "amplitude", 1.0), get(&p, "period", 10.0), get(&p, "offset", 0.0));
-            if kind == "sine" {
-                Signal::Sine { amplitude, period, offset }
-            } else {
-                Signal::Triangle { amplitude, period, offset }
-            }
-        }
-        "random-walk" | "random_walk" | "randomwalk" => {
-            let p = pairs(rest, &what, &["std", "offset", "seed"])?;
-            Signal::RandomWalk {
-                step_std: get(&p, "std", 0.1),
-                offset: get(&p, "offset", 0.0),
-                seed: seed_value(get(&p, "seed", 1.0), &what)?,
-            }
-        }
-        "steps" => {
-            let p = pairs(rest, &what, &["amplitude", "hold", "offset", "seed"])?;
-            Signal::Steps {
-                amplitude: get(&p, "amplitude", 1.0),
-                hold: get(&p, "hold", 10.0),
-                offset: get(&p, "offset", 0.0),
-                seed: seed_value(get(&p, "seed", 1.0), &what)?,
-            }
-        }
-        "step" => {
-            let p = pairs(rest, &what, &["from", "to", "at"])?;
-            Signal::Step { from: get(&p, "from", 50.0), to: get(&p, "to", 51.0), at: get(&p, "at", 10.0) }
-        }
-        "const" | "constant" => {
-            let p = pairs(rest, &what, &["value"])?;
-            Signal::Constant { value: get(&p, "value", 50.0) }
-        }
-        other => bail!(
-            "{flag}: unknown signal '{other}'; the signals are sine, triangle, random-walk, steps, step, const (e.g. {flag} sine:amplitude=1,period=10)"
-        ),
-    };
-    s.validate().map_err(|e| anyhow::anyhow!("{what}: {e}"))?;
-    Ok(s)
-}
-
-fn seed_value(v: f64, what: &str) -> Result<u64> {
-    if v >= 0.0 && v.fract() == 0.0 && v < 1.8e19 {
-        Ok(v as u64)
-    } else {
-        bail!("{what}: seed must be a whole number >= 0")
-    }
+    Ok(core_spec::signal(text, flag)?)
 }
 
 /// `foptd:K=3,tau=10,delay=10` or `integrating:K=0.02,delay=2`.
 pub fn process(text: &str) -> Result<Process> {
-    let (kind, rest) = text.split_once(':').unwrap_or((text, ""));
-    let what = format!("--process {text}");
-    let p = match kind.trim().to_ascii_lowercase().as_str() {
-        "foptd" => {
-            let p = pairs(rest, &what, &["K", "tau", "delay"])?;
-            Process::Foptd { k: get(&p, "K", 3.0), tau: get(&p, "tau", 10.0), delay: get(&p, "delay", 10.0) }
-        }
-        "integrating" => {
-            let p = pairs(rest, &what, &["K", "delay"])?;
-            Process::Integrating { k: get(&p, "K", 0.02), delay: get(&p, "delay", 2.0) }
-        }
-        other => bail!("--process: unknown process '{other}'; use foptd:K=3,tau=10,delay=10 or integrating:K=0.02,delay=2"),
-    };
-    p.validate().map_err(|e| anyhow::anyhow!("{what}: {e}"))?;
-    Ok(p)
+    Ok(core_spec::process(text, "--process")?)
 }
 
 /// `Kc=0.2,Ti=10`.
 pub fn pi(text: &str) -> Result<Pi> {
-    let p = pairs(text, &format!("--pi {text}"), &["Kc", "Ti"])?;
-    Ok(Pi {
-        kc: get(&p, "Kc", 0.2),
-        ti: get(&p, "Ti", 10.0),
-    })
+    Ok(core_spec::pi(text, "--pi")?)
 }
 
 pub fn model_kind(text: &str) -> Result<ModelKind> {
@@ -139,35 +28,7 @@ pub fn model_kind(text: &str) -> Result<ModelKind> {
 
 /// A model from `--param NAME=VALUE` flags (each flag may hold several, comma-separated).
 pub fn model(kind: ModelKind, params: &[String]) -> Result<Model> {
-    let names = kind.param_names();
-    let mut given: Vec<(String, f64)> = Vec::new();
-    for text in params {
-        for (n, v) in pairs(text, &format!("--param for model {kind}"), &names)? {
-            if given.iter().any(|(g, _)| *g == n) {
-                bail!("--param: {n} is given twice");
-            }
-            given.push((n, v));
-        }
-    }
-    let mut values = Vec::new();
-    for spec in kind.params() {
-        let v = given
-            .iter()
-            .find(|(n, _)| n == spec.name)
-            .map(|(_, v)| *v)
-            .with_context(|| {
-                format!(
-                    "model {kind} needs --param {}=VALUE ({}, {}); its parameters are {}",
-                    spec.name,
-                    spec.description,
-                    spec.unit,
-                    names.join(", ")
-                )
-            })?;
-        values.push(v);
-    }
-    kind.build(&values)
-        .map_err(|e| anyhow::anyhow!("--param: {e}"))
+    Ok(core_spec::model(kind, params, "--param")?)
 }
 
 /// `--bounds NAME=LO:HI` flags applied over default ranges (one per parameter of the model).

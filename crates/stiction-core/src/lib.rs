@@ -41,10 +41,12 @@ pub mod loop_analysis;
 pub mod models;
 pub mod quality;
 pub mod quantify;
+pub mod record;
 pub mod reproduce;
 pub mod rng;
 pub mod sim;
 pub mod sim_check;
+pub mod spec;
 pub mod spectral;
 
 pub use estimate::{estimate, Estimate, Method, Request};

@@ -17,7 +17,7 @@ pub mod time;
 mod proptests;
 
 pub use format::in_guarded_reader;
-pub use missing::longest_clean;
+pub use stiction_core::record::longest_clean;
 pub use table::Table;
 pub use text::sniff_delimiter;
 pub use time::{TimeFormat, TimeSpec};
@@ -32,29 +32,7 @@ pub struct ReadOptions {
     pub sheet: Option<String>,
 }
 
-/// A number with a decimal point, or with a decimal comma and no point (`12,5`).
-pub(crate) fn parse_number(cell: &str) -> Option<f64> {
-    cell.parse().ok().or_else(|| {
-        (cell.matches(',').count() == 1 && !cell.contains('.'))
-            .then(|| cell.replace(',', ".").parse().ok())
-            .flatten()
-    })
-}
-
-/// The median step of a time column, if time increases (NaN entries are skipped), rounded to
-/// the microsecond: timestamps since 1970 carry about 1e-7 s of float noise.
-pub fn sampling_time(t: &[f64]) -> Option<f64> {
-    let finite: Vec<f64> = t.iter().copied().filter(|v| v.is_finite()).collect();
-    let mut steps: Vec<f64> = finite.windows(2).map(|w| w[1] - w[0]).collect();
-    if steps.is_empty() {
-        return None;
-    }
-    steps.sort_by(f64::total_cmp);
-    let ts = steps[steps.len() / 2];
-    let rounded = (ts * 1e6).round() / 1e6;
-    let ts = if rounded > 0.0 { rounded } else { ts };
-    (ts > 0.0 && ts.is_finite()).then_some(ts)
-}
+pub(crate) use stiction_core::record::parse_number;
 
 /// The time column: `--time COL` if given, else the first of t, time, timestamp.
 pub fn time_column(table: &Table, explicit: Option<&str>) -> Result<Option<usize>> {

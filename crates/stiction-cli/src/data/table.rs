@@ -202,11 +202,10 @@ impl Table {
         let mut out = Vec::with_capacity(self.len());
         for i in 0..self.len() {
             let cell = self.cell(i, col);
-            let auto = match cell.to_ascii_lowercase().as_str() {
-                "auto" | "automatic" | "aut" | "a" | "1" | "true" | "on" | "cascade" | "cas" => true,
-                "manual" | "man" | "m" | "0" | "false" | "off" => false,
-                _ if is_missing(cell) => false,
-                _ => bail!(
+            let auto = match stiction_core::record::mode_word(cell) {
+                Some(auto) => auto,
+                None if is_missing(cell) => false,
+                None => bail!(
                     "{file}: {}, column '{name}': '{}' is not a controller mode; use auto or manual (also 1 or 0)",
                     self.at(i),
                     shown(cell)

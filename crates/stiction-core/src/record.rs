@@ -1,0 +1,414 @@
+//! Preparing a loop record from its columns, as every front end needs it: the CLI from a file's
+//! table, the Python package from a pandas DataFrame or numpy arrays. Gaps are NaN; a row whose
+//! time is missing is a gap and its time is filled in between its neighbours; rows are put in
+//! time order (a row repeating a time dropped); the sampling time is the median step.
+//!
+//! Pure functions over slices: the signals are borrowed ([`Cow`]) and copied only when a gap in
+//! time or the time order calls for it, so a front end reads its arrays without copies.
+
+use crate::diagnose::LoopRecord;
+use std::borrow::Cow;
+
+/// The signals of one loop, as columns (gaps NaN; `auto` `true` where the controller is in
+/// automatic; `time` in seconds).
+#[derive(Debug, Clone)]
+pub struct Signals<'a> {
+    pub op: Cow<'a, [f64]>,
+    pub pv: Cow<'a, [f64]>,
+    pub sp: Option<Cow<'a, [f64]>>,
+    pub mv: Option<Cow<'a, [f64]>>,
+    pub auto: Option<Cow<'a, [bool]>>,
+    pub time: Option<Cow<'a, [f64]>>,
+}
+
+impl<'a> Signals<'a> {
+    /// Borrowed signals without sp, mv, mode or time.
+    pub fn new(op: &'a [f64], pv: &'a [f64]) -> Signals<'a> {
+        Signals {
+            op: Cow::Borrowed(op),
+            pv: Cow::Borrowed(pv),
+            sp: None,
+            mv: None,
+            auto: None,
+            time: None,
+        }
+    }
+
+    /// The record `diagnose` judges.
+    pub fn record(&self) -> LoopRecord<'_> {
+        LoopRecord {
+            op: &self.op,
+            pv: &self.pv,
+            sp: self.sp.as_deref(),
+            mv: self.mv.as_deref(),
+            time: self.time.as_deref(),
+            auto: self.auto.as_deref(),
+        }
+    }
+}
+
+/// A record ready for `diagnose`: its signals in time order, the sampling time, and what was
+/// decided on the way.
+#[derive(Debug, Clone)]
+pub struct Prepared<'a> {
+    pub signals: Signals<'a>,
+    /// Sampling time, seconds.
+    pub ts: f64,
+    /// What a person should know (rows sorted, repeated times dropped, no time values).
+    pub notes: Vec<String>,
+    /// The input row of each sample, when the rows were sorted by time (else sample k is row k).
+    pub rows: Option<Vec<usize>>,
+}
+
+/// Why a record cannot be prepared.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PrepareError {
+    #[error("the sampling time must be a positive number of seconds, got {0}")]
+    Ts(f64),
+    #[error("the time column does not increase; give the sampling time")]
+    TimeNotIncreasing,
+    #[error("{signal} has {len} samples but op has {op}: the signals must have the same length")]
+    Length {
+        signal: &'static str,
+        len: usize,
+        op: usize,
+    },
+}
+
+fn check_lengths(s: &Signals) -> Result<(), PrepareError> {
+    let op = s.op.len();
+    let lens = [
+        ("pv", Some(s.pv.len())),
+        ("sp", s.sp.as_ref().map(|v| v.len())),
+        ("mv", s.mv.as_ref().map(|v| v.len())),
+        ("mode", s.auto.as_ref().map(|v| v.len())),
+        ("time", s.time.as_ref().map(|v| v.len())),
+    ];
+    for (signal, len) in lens {
+        if let Some(len) = len.filter(|&l| l != op) {
+            return Err(PrepareError::Length { signal, len, op });
+        }
+    }
+    Ok(())
+}
+
+/// Prepare a record: a sample without its time becomes a gap (its time filled in), rows are put
+/// in time order, and the sampling time is `ts` if given, else the median step of the time,
+/// else 1 s.
+pub fn prepare<'a>(mut s: Signals<'a>, ts: Option<f64>) -> Result<Prepared<'a>, PrepareError> {
+    if let Some(ts) = ts {
+        if !(ts > 0.0 && ts.is_finite()) {
+            return Err(PrepareError::Ts(ts));
+        }
+    }
+    check_lengths(&s)?;
+    let mut notes = Vec::new();
+    if let Some(t) = s.time.as_deref() {
+        let missing: Vec<usize> = (0..t.len()).filter(|&k| t[k].is_nan()).collect();
+        if !missing.is_empty() {
+            gaps_where_time_is_missing(&mut s, &missing);
+        }
+    }
+    if let Some(t) = &mut s.time {
+        if t.iter().any(|v| v.is_nan()) && !fill_times(t.to_mut()) {
+            notes.push("the time column has no values; it is left out".into());
+            s.time = None;
+        }
+    }
+    let mut rows = None;
+    if let Some((keep, note)) = s.time.as_deref().and_then(time_order) {
+        notes.push(note);
+        reorder(&mut s, &keep);
+        rows = Some(keep);
+    }
+    let ts = match (ts, s.time.as_deref()) {
+        (Some(ts), _) => ts,
+        (None, Some(t)) => sampling_time(t).ok_or(PrepareError::TimeNotIncreasing)?,
+        (None, None) => 1.0,
+    };
+    Ok(Prepared {
+        signals: s,
+        ts,
+        notes,
+        rows,
+    })
+}
+
+/// A row without its time is a gap in op, pv, sp and mv.
+fn gaps_where_time_is_missing(s: &mut Signals, missing: &[usize]) {
+    for v in [
+        Some(&mut s.op),
+        Some(&mut s.pv),
+        s.sp.as_mut(),
+        s.mv.as_mut(),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        let v = v.to_mut();
+        for &k in missing {
+            v[k] = f64::NAN;
+        }
+    }
+}
+
+fn pick<T: Copy>(v: &[T], keep: &[usize]) -> Vec<T> {
+    keep.iter().map(|&k| v[k]).collect()
+}
+
+/// Keep the rows `keep`, in that order, in every signal.
+fn reorder(s: &mut Signals, keep: &[usize]) {
+    s.op = Cow::Owned(pick(&s.op, keep));
+    s.pv = Cow::Owned(pick(&s.pv, keep));
+    for v in [s.sp.as_mut(), s.mv.as_mut(), s.time.as_mut()]
+        .into_iter()
+        .flatten()
+    {
+        *v = Cow::Owned(pick(v, keep));
+    }
+    if let Some(a) = s.auto.as_mut() {
+        *a = Cow::Owned(pick(a, keep));
+    }
+}
+
+/// The median step of a time column, if time increases (NaN entries are skipped), rounded to
+/// the microsecond: timestamps since 1970 carry about 1e-7 s of float noise.
+pub fn sampling_time(t: &[f64]) -> Option<f64> {
+    let finite: Vec<f64> = t.iter().copied().filter(|v| v.is_finite()).collect();
+    let mut steps: Vec<f64> = finite.windows(2).map(|w| w[1] - w[0]).collect();
+    if steps.is_empty() {
+        return None;
+    }
+    steps.sort_by(f64::total_cmp);
+    let ts = steps[steps.len() / 2];
+    let rounded = (ts * 1e6).round() / 1e6;
+    let ts = if rounded > 0.0 { rounded } else { ts };
+    (ts > 0.0 && ts.is_finite()).then_some(ts)
+}
+
+/// Fill NaN times by straight lines between their neighbours (by the median step past the
+/// ends). False when no time is known.
+pub fn fill_times(t: &mut [f64]) -> bool {
+    let known: Vec<usize> = (0..t.len()).filter(|&k| t[k].is_finite()).collect();
+    let (Some(&first), Some(&last)) = (known.first(), known.last()) else {
+        return false;
+    };
+    // the median step per sample between known times (neighbours or not)
+    let mut steps: Vec<f64> = known
+        .windows(2)
+        .map(|w| (t[w[1]] - t[w[0]]) / (w[1] - w[0]) as f64)
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    let step = steps.get(steps.len() / 2).copied().unwrap_or(1.0);
+    for k in 0..first {
+        t[k] = t[first] - (first - k) as f64 * step;
+    }
+    for k in last + 1..t.len() {
+        t[k] = t[last] + (k - last) as f64 * step;
+    }
+    for w in known.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        for k in a + 1..b {
+            t[k] = t[a] + (t[b] - t[a]) * (k - a) as f64 / (b - a) as f64;
+        }
+    }
+    true
+}
+
+fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+/// The rows to keep, in time order, when the time is not in order or repeats (the first row of
+/// each time kept), with a note; `None` when time only increases.
+pub fn time_order(t: &[f64]) -> Option<(Vec<usize>, String)> {
+    if t.windows(2).all(|w| w[1] > w[0]) {
+        return None;
+    }
+    let backwards = t.windows(2).filter(|w| w[1] < w[0]).count();
+    let mut keep: Vec<usize> = (0..t.len()).collect();
+    keep.sort_by(|&a, &b| t[a].total_cmp(&t[b]).then(a.cmp(&b)));
+    let before = keep.len();
+    keep.dedup_by(|b, a| t[*a] == t[*b]);
+    let repeats = before - keep.len();
+    let mut said = Vec::new();
+    if backwards > 0 {
+        said.push(format!(
+            "the rows are not in time order ({} back): sorted by time",
+            count(backwards, "step goes", "steps go")
+        ));
+    }
+    if repeats > 0 {
+        said.push(format!(
+            "{} an earlier row's time: the first row of each time is kept",
+            count(repeats, "row repeats", "rows repeat")
+        ));
+    }
+    Some((keep, said.join("; ")))
+}
+
+// The cells of plant exports: missing values as historians write them, numbers with a
+// decimal comma. Blank cells, `NaN`, `#N/A` and historian states are gaps, not errors.
+
+/// Cell texts read as a missing value (compared case-insensitively, after trimming). The last
+/// ones are OSIsoft PI's system digital states for a failed or absent reading, and Excel's cell
+/// errors.
+pub const MISSING_MARKERS: &[&str] = &[
+    "",
+    "nan",
+    "-nan",
+    "#n/a",
+    "null",
+    "none",
+    "bad",
+    "bad input",
+    "bad data",
+    "bad quality",
+    "i/o timeout",
+    "shutdown",
+    "comm fail",
+    "no data",
+    "no sample",
+    "calc failed",
+    "scan off",
+    "scan timeout",
+    "pt created",
+    "configure",
+    "not connected",
+    "intf shut",
+    "out of serv",
+    "invalid data",
+    "#value!",
+    "#div/0!",
+    "#ref!",
+    "#num!",
+    "#null!",
+    "#name?",
+];
+
+/// Whether a cell's text stands for a missing value.
+pub fn is_missing(cell: &str) -> bool {
+    let c = cell.trim();
+    c.len() <= 13 && MISSING_MARKERS.iter().any(|m| m.eq_ignore_ascii_case(c))
+}
+
+/// A number with a decimal point, or with a decimal comma and no point (`12,5`).
+pub fn parse_number(cell: &str) -> Option<f64> {
+    cell.parse().ok().or_else(|| {
+        (cell.matches(',').count() == 1 && !cell.contains('.'))
+            .then(|| cell.replace(',', ".").parse().ok())
+            .flatten()
+    })
+}
+
+/// A controller mode cell in words: `Some(true)` for automatic (auto, automatic, aut, a, 1, true,
+/// on, cascade, cas), `Some(false)` for manual (manual, man, m, 0, false, off), any case;
+/// `None` for anything else (a missing cell is the front end's to judge).
+pub fn mode_word(cell: &str) -> Option<bool> {
+    match cell.trim().to_ascii_lowercase().as_str() {
+        "auto" | "automatic" | "aut" | "a" | "1" | "true" | "on" | "cascade" | "cas" => Some(true),
+        "manual" | "man" | "m" | "0" | "false" | "off" => Some(false),
+        _ => None,
+    }
+}
+
+/// The longest run of rows `[start, end)` where every column holds a finite value (the first such
+/// run when several are equally long); `None` when no row does. Fits (`quantify`, `estimate`)
+/// use it: they need a record without gaps.
+pub fn longest_clean(columns: &[&[f64]]) -> Option<(usize, usize)> {
+    let n = columns.iter().map(|c| c.len()).min()?;
+    let clean = |k: usize| columns.iter().all(|c| c[k].is_finite());
+    let mut best: Option<(usize, usize)> = None;
+    let mut start = None;
+    for k in 0..=n {
+        match (start, k < n && clean(k)) {
+            (None, true) => start = Some(k),
+            (Some(s), false) => {
+                if best.is_none_or(|(a, b)| k - s > b - a) {
+                    best = Some((s, k));
+                }
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn missing_times_are_filled_between_neighbours() {
+        let nan = f64::NAN;
+        let mut t = [nan, 1.0, nan, nan, 4.0, nan];
+        assert!(fill_times(&mut t));
+        assert_eq!(t, [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+        assert!(!fill_times(&mut [nan, nan]));
+    }
+
+    #[test]
+    fn rows_are_sorted_and_repeats_dropped() {
+        assert!(time_order(&[0.0, 1.0, 2.0]).is_none());
+        let (keep, note) = time_order(&[0.0, 2.0, 1.0, 2.0, 3.0]).unwrap();
+        assert_eq!(keep, vec![0, 2, 1, 4]);
+        assert!(
+            note.contains("1 step goes back") && note.contains("1 row repeats"),
+            "{note}"
+        );
+    }
+
+    #[test]
+    fn the_longest_clean_run() {
+        let nan = f64::NAN;
+        let a = [1.0, nan, 1.0, 1.0, 1.0, 1.0, nan];
+        let b = [1.0, 1.0, 1.0, nan, 1.0, 1.0, 1.0];
+        assert_eq!(longest_clean(&[&a, &b]), Some((4, 6)));
+        assert_eq!(longest_clean(&[&a]), Some((2, 6)));
+        assert_eq!(longest_clean(&[&[nan, nan]]), None);
+        assert_eq!(longest_clean(&[&[]]), None);
+    }
+
+    #[test]
+    fn signals_in_order_are_not_copied() {
+        let op = [1.0, 2.0, 3.0];
+        let pv = [0.0, 0.5, 1.0];
+        let t = [0.0, 2.0, 4.0];
+        let mut s = Signals::new(&op, &pv);
+        s.time = Some(Cow::Borrowed(&t));
+        let p = prepare(s, None).unwrap();
+        assert_eq!(p.ts, 2.0);
+        assert!(matches!(p.signals.op, Cow::Borrowed(_)));
+        assert!(p.rows.is_none() && p.notes.is_empty());
+    }
+
+    #[test]
+    fn a_row_without_time_is_a_gap_and_rows_are_sorted() {
+        let nan = f64::NAN;
+        let op = [1.0, 2.0, 3.0, 4.0];
+        let pv = [0.0, 0.5, 1.0, 1.5];
+        let sp = [5.0; 4];
+        let t = [0.0, nan, 3.0, 2.0];
+        let mut s = Signals::new(&op, &pv);
+        s.sp = Some(Cow::Borrowed(&sp));
+        s.time = Some(Cow::Borrowed(&t));
+        let p = prepare(s, None).unwrap();
+        // t filled to [0, 1.5, 3, 2], then sorted: rows 0, 1, 3, 2
+        assert_eq!(p.rows, Some(vec![0, 1, 3, 2]));
+        assert!(p.signals.op[1].is_nan() && p.signals.sp.as_ref().unwrap()[1].is_nan());
+        assert_eq!(p.signals.op[2], 4.0);
+        assert_eq!(
+            prepare(Signals::new(&op, &pv[..2]), None).unwrap_err(),
+            PrepareError::Length {
+                signal: "pv",
+                len: 2,
+                op: 4
+            }
+        );
+        assert_eq!(
+            prepare(Signals::new(&op, &pv), Some(0.0)).unwrap_err(),
+            PrepareError::Ts(0.0)
+        );
+    }
+}

@@ -1,0 +1,94 @@
+"""Result objects: thin views over the core's result structs, serialised by the same serde code
+the CLI's ``--json`` uses, so ``to_dict()`` equals the CLI's JSON key for key."""
+
+from __future__ import annotations
+
+import copy
+import json
+from typing import Any, Dict, List
+
+import pandas as pd
+
+
+class _Result:
+    """Attributes are the JSON's top-level keys (``result.verdict``, ``result.band``, ...)."""
+
+    _what = "result"
+
+    def __init__(self, text: str, notes: List[str]):
+        self._d: Dict[str, Any] = json.loads(text)
+        #: What the preparation of the record decided (rows sorted, gaps), as the CLI's notes.
+        self.notes: List[str] = list(notes)
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The result as a dict: the CLI's JSON for the same data, key for key."""
+        return copy.deepcopy(self._d)
+
+    def keys(self) -> List[str]:
+        return list(self._d)
+
+    def __getattr__(self, name: str) -> Any:
+        d = self.__dict__.get("_d")
+        if d is not None and name in d:
+            return d[name]
+        raise AttributeError(f"{type(self).__name__} has no attribute '{name}'; it has {', '.join(d or [])}")
+
+    def __dir__(self) -> List[str]:
+        return sorted(set(super().__dir__()) | set(self._d))
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, type(self)) and self._d == other._d
+
+
+class Diagnosis(_Result):
+    """The diagnosis of one loop (``stiction diagnose --json``).
+
+    Main attributes: ``verdict`` (``stiction``, ``no_stiction``, ``undetermined``,
+    ``insufficient_data``), ``confidence``, ``reason``, ``next_step``, ``band`` (the stiction band
+    in % of valve span and where it comes from, for a ``stiction`` verdict), ``families`` (the
+    evidence and their votes), ``indices`` (the shape indices), ``oscillation``, ``quality``
+    (the data-quality gates), ``samples``, ``ts``, ``warnings``.
+    """
+
+    @property
+    def windows(self) -> pd.DataFrame:
+        """The verdict per window (``window=`` samples) as a DataFrame; empty without windows."""
+        rows = self._d.get("windows") or []
+        return pd.DataFrame(rows, columns=None if rows else ["start", "end", "t_start", "t_end", "verdict", "confidence", "reason", "period", "votes"])
+
+    @property
+    def band_percent(self) -> Any:
+        """The stiction band in % of valve span, or None."""
+        b = self._d.get("band")
+        return None if b is None else b.get("band_percent_of_span")
+
+    def indices_frame(self) -> pd.DataFrame:
+        """The shape indices (name, value, vote, threshold, ...) as a DataFrame."""
+        return pd.DataFrame(self._d.get("indices") or [])
+
+    def __repr__(self) -> str:
+        c = self._d.get("confidence")
+        conf = "" if c is None else f", confidence {c:.2f}"
+        band = self.band_percent
+        b = "" if band is None else f", band {band:.2f} % of span"
+        return f"<Diagnosis {self._d.get('verdict')}{conf}{b}; {self._d.get('samples')} samples>"
+
+
+class Quantification(_Result):
+    """Stiction quantified from OP and PV (``stiction quantify --json``): ``apparent_stiction``,
+    ``params``, ``interval``, ``fit``, ``linear_model``, ``status``, ``mv`` (the estimated
+    valve position), ``pv_simulated``."""
+
+    def __repr__(self) -> str:
+        return (
+            f"<Quantification {self._d.get('model')} {self._d.get('method')}: "
+            f"apparent stiction {self._d.get('apparent_stiction')}, status {self._d.get('status')}>"
+        )
+
+
+class Estimate(_Result):
+    """Model parameters estimated from OP and MV (``stiction estimate --json``): ``params``,
+    ``interval`` (the proven optimal set for ``exact``), ``sse``, ``r2``, ``certificate``."""
+
+    def __repr__(self) -> str:
+        return f"<Estimate {self._d.get('model')} {self._d.get('method')}: {self._d.get('params')}, R² {self._d.get('r2')}>"

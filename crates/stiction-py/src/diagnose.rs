@@ -1,0 +1,117 @@
+//! `diagnose`: one loop, through the core's record preparation and diagnosis (as the CLI's
+//! `diagnose`), the GIL released while it runs.
+
+use crate::{bad, json, slice, slice_bool};
+use numpy::PyReadonlyArray1;
+use pyo3::prelude::*;
+use stiction_core::diagnose::{self as core, DiagnoseError, DiagnoseRequest, Diagnosis};
+use stiction_core::record::{self, PrepareError, Signals};
+
+/// What every diagnosis is asked besides the signals (the CLI's column flags).
+#[derive(Clone, Debug)]
+pub struct Settings {
+    pub ts: Option<f64>,
+    pub integrating: bool,
+    pub window: Option<usize>,
+    pub quantify: bool,
+    pub op_range: [f64; 2],
+    pub estimate_start: bool,
+    /// The time column's name, for the sentence when time does not increase.
+    pub time_name: String,
+}
+
+impl Settings {
+    /// The core's request, as the CLI's `Columns::request` builds it.
+    pub fn request(&self, ts: f64) -> DiagnoseRequest {
+        DiagnoseRequest {
+            ts,
+            integrating: self.integrating,
+            estimate_start: self.estimate_start,
+            op_range: self.op_range,
+            window: self.window,
+            quantify: self.quantify,
+            ..DiagnoseRequest::default()
+        }
+    }
+}
+
+/// The core's preparation error in one sentence naming the argument.
+pub fn prepare_error(e: PrepareError, s: &Settings) -> String {
+    match e {
+        PrepareError::Ts(ts) => {
+            format!("ts={ts}: the sampling time must be a positive number of seconds")
+        }
+        PrepareError::TimeNotIncreasing => format!(
+            "the time column '{}' does not increase; give the sampling time with ts=SECONDS",
+            s.time_name
+        ),
+        e => e.to_string(),
+    }
+}
+
+/// The core's diagnosis error in one sentence naming the argument (the CLI's `core_error`, with
+/// keyword arguments for flags).
+pub fn diagnose_error(e: DiagnoseError) -> String {
+    match e {
+        DiagnoseError::Window { window, least } => format!(
+            "window={window}: a window needs at least {least} samples; give a larger window"
+        ),
+        DiagnoseError::Ts(ts) => {
+            format!("ts={ts}: the sampling time must be a positive number of seconds")
+        }
+        DiagnoseError::OpRange { lo, hi } => format!(
+            "op_range=({lo}, {hi}): the value of a fully open valve must exceed that of a closed one"
+        ),
+        e => e.to_string(),
+    }
+}
+
+/// Prepare and diagnose one loop: the diagnosis and the notes, or one sentence.
+pub fn run(signals: Signals<'_>, s: &Settings) -> Result<(Diagnosis, Vec<String>), String> {
+    let p = record::prepare(signals, s.ts).map_err(|e| prepare_error(e, s))?;
+    let d = core::diagnose(&p.signals.record(), &s.request(p.ts)).map_err(diagnose_error)?;
+    Ok((d, p.notes))
+}
+
+/// Diagnose one loop: the `Diagnosis` as JSON (the CLI's `diagnose --json`) and the notes of
+/// the record's preparation (rows sorted, repeated times dropped).
+#[pyfunction]
+#[pyo3(signature = (op, pv, sp=None, mv=None, auto=None, time=None, ts=None, integrating=false,
+    window=None, quantify=true, op_range=(0.0, 100.0), estimate_start=false, time_name=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn diagnose(
+    py: Python<'_>,
+    op: PyReadonlyArray1<'_, f64>,
+    pv: PyReadonlyArray1<'_, f64>,
+    sp: Option<PyReadonlyArray1<'_, f64>>,
+    mv: Option<PyReadonlyArray1<'_, f64>>,
+    auto: Option<PyReadonlyArray1<'_, bool>>,
+    time: Option<PyReadonlyArray1<'_, f64>>,
+    ts: Option<f64>,
+    integrating: bool,
+    window: Option<usize>,
+    quantify: bool,
+    op_range: (f64, f64),
+    estimate_start: bool,
+    time_name: Option<String>,
+) -> PyResult<(String, Vec<String>)> {
+    let settings = Settings {
+        ts,
+        integrating,
+        window,
+        quantify,
+        op_range: [op_range.0, op_range.1],
+        estimate_start,
+        time_name: time_name.unwrap_or_else(|| "time".into()),
+    };
+    let signals = Signals {
+        op: slice(&op),
+        pv: slice(&pv),
+        sp: sp.as_ref().map(slice),
+        mv: mv.as_ref().map(slice),
+        auto: auto.as_ref().map(slice_bool),
+        time: time.as_ref().map(slice),
+    };
+    let (d, notes) = py.detach(|| run(signals, &settings)).map_err(bad)?;
+    Ok((json(&d)?, notes))
+}
