@@ -3,14 +3,67 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The data-quality gates a record goes through (in JSON, the snake_case name).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Gate {
+    /// Enough samples for a verdict (value and limit in samples).
+    RecordLength,
+    /// OP at 0 %, 100 % or pinned at its own extreme (value and limit: shares of the samples).
+    OpSaturated,
+    /// PV repeating its previous value exactly (value and limit: shares of the samples).
+    PvFrozen,
+    /// PV repeating itself or running in exactly straight lines, as a historian's compression
+    /// leaves it (value and limit: shares of the samples).
+    PvCompressed,
+    /// Too few distinct PV levels (value: distinct levels; limit: levels per 100 samples).
+    PvQuantised,
+    /// The controller in manual (value and limit: shares of the samples).
+    ManualMode,
+    /// Samples with a missing value (NaN), left out (value: share of the samples; limit 1, so it
+    /// reports and never fails).
+    MissingValues,
+    /// Setpoint changes (value and limit: counts; `diagnose` keeps them and never fails on them).
+    SetpointChanges,
+    /// Gaps in the time axis or time not increasing (value: gaps or breaks; limit 0).
+    TimeGaps,
+}
+
+impl Gate {
+    /// The gate's name, as in JSON: `op_saturated`, `time_gaps`, ...
+    pub fn name(self) -> &'static str {
+        match self {
+            Gate::RecordLength => "record_length",
+            Gate::OpSaturated => "op_saturated",
+            Gate::PvFrozen => "pv_frozen",
+            Gate::PvCompressed => "pv_compressed",
+            Gate::PvQuantised => "pv_quantised",
+            Gate::ManualMode => "manual_mode",
+            Gate::MissingValues => "missing_values",
+            Gate::SetpointChanges => "setpoint_changes",
+            Gate::TimeGaps => "time_gaps",
+        }
+    }
+}
+
+impl std::fmt::Display for Gate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// One gate's finding.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Finding {
-    pub gate: String,
+    /// Which gate.
+    pub gate: Gate,
+    /// Whether the record passed it.
     pub passed: bool,
-    /// The measured quantity and the limit it is held to.
+    /// The measured quantity and the limit it is held to (units per gate, see [`Gate`]).
     pub value: f64,
+    /// The limit `value` is held to.
     pub limit: f64,
+    /// One sentence saying what was measured, for people.
     pub message: String,
 }
 
@@ -72,9 +125,9 @@ impl<'a> Record<'a> {
     }
 }
 
-fn finding(gate: &str, passed: bool, value: f64, limit: f64, message: String) -> Finding {
+fn finding(gate: Gate, passed: bool, value: f64, limit: f64, message: String) -> Finding {
     Finding {
-        gate: gate.into(),
+        gate,
         passed,
         value,
         limit,
@@ -113,7 +166,7 @@ pub fn check(r: &Record, limits: &Limits) -> Vec<Finding> {
     }
     let share = if hi > lo { at_limit as f64 / n } else { 1.0 };
     out.push(finding(
-        "op_saturated",
+        Gate::OpSaturated,
         share <= limits.saturated_share,
         share,
         limits.saturated_share,
@@ -125,7 +178,7 @@ pub fn check(r: &Record, limits: &Limits) -> Vec<Finding> {
 
     let repeats = r.pv.windows(2).filter(|w| w[1] == w[0]).count() as f64 / (n - 1.0).max(1.0);
     out.push(finding(
-        "pv_frozen",
+        Gate::PvFrozen,
         repeats <= limits.repeated_share,
         repeats,
         limits.repeated_share,
@@ -140,7 +193,7 @@ pub fn check(r: &Record, limits: &Limits) -> Vec<Finding> {
     levels.dedup();
     let per_100 = 100.0 * levels.len() as f64 / n;
     out.push(finding(
-        "pv_quantised",
+        Gate::PvQuantised,
         // fifty levels are enough to see a shape, however long the record
         per_100 >= limits.levels_per_100 || levels.len() >= 50,
         levels.len() as f64,
@@ -151,7 +204,7 @@ pub fn check(r: &Record, limits: &Limits) -> Vec<Finding> {
     if let Some(auto) = r.auto {
         let manual = auto.iter().filter(|&&a| !a).count() as f64 / n;
         out.push(finding(
-            "manual_mode",
+            Gate::ManualMode,
             manual <= limits.manual_share,
             manual,
             limits.manual_share,
@@ -165,7 +218,7 @@ pub fn check(r: &Record, limits: &Limits) -> Vec<Finding> {
     if let Some(sp) = r.sp {
         let changes = sp.windows(2).filter(|w| w[1] != w[0]).count();
         out.push(finding(
-            "setpoint_changes",
+            Gate::SetpointChanges,
             changes <= limits.setpoint_changes,
             changes as f64,
             limits.setpoint_changes as f64,
@@ -194,7 +247,7 @@ pub fn time_gaps(t: &[f64], limits: &Limits) -> Finding {
         0
     };
     finding(
-        "time_gaps",
+        Gate::TimeGaps,
         gaps == 0 && backwards == 0 && ts > 0.0,
         gaps as f64,
         0.0,
@@ -280,11 +333,8 @@ mod tests {
         (op, pv)
     }
 
-    fn failed(f: &[Finding]) -> Vec<String> {
-        f.iter()
-            .filter(|f| !f.passed)
-            .map(|f| f.gate.clone())
-            .collect()
+    fn failed(f: &[Finding]) -> Vec<Gate> {
+        f.iter().filter(|f| !f.passed).map(|f| f.gate).collect()
     }
 
     #[test]
@@ -336,13 +386,13 @@ mod tests {
         };
         let f = failed(&check(&r, &Limits::default()));
         for gate in [
-            "op_saturated",
-            "pv_frozen",
-            "manual_mode",
-            "setpoint_changes",
-            "time_gaps",
+            Gate::OpSaturated,
+            Gate::PvFrozen,
+            Gate::ManualMode,
+            Gate::SetpointChanges,
+            Gate::TimeGaps,
         ] {
-            assert!(f.contains(&gate.to_string()), "{gate} not failed: {f:?}");
+            assert!(f.contains(&gate), "{gate} not failed: {f:?}");
         }
     }
 
@@ -397,6 +447,6 @@ mod tests {
             time: None,
             auto: None,
         };
-        assert!(failed(&check(&r, &Limits::default())).contains(&"pv_quantised".to_string()));
+        assert!(failed(&check(&r, &Limits::default())).contains(&Gate::PvQuantised));
     }
 }

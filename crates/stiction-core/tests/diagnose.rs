@@ -2,6 +2,7 @@
 
 use stiction_core::diagnose::{diagnose, DiagnoseRequest, Family, LoopRecord, Verdict, Vote};
 use stiction_core::models::{Model, Stenman};
+use stiction_core::quality::Gate;
 use stiction_core::sim::{ClosedLoop, LoopData, Process, Signal};
 
 fn run(d: f64, f: impl FnOnce(&mut ClosedLoop)) -> LoopData {
@@ -96,7 +97,10 @@ fn unusable_samples_are_left_out_and_gaps_split_the_record() {
     let d = diagnose(&r, &quick()).unwrap();
     assert_eq!(d.stretches, vec![[0, 1200], [1200, 2000]]);
     assert_eq!(d.analysed, [0, 1200]);
-    assert!(d.quality.iter().any(|f| f.gate == "time_gaps" && !f.passed));
+    assert!(d
+        .quality
+        .iter()
+        .any(|f| f.gate == Gate::TimeGaps && !f.passed));
     assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
     // missing values (NaN) split it too
     let mut pv = sticky.pv.clone();

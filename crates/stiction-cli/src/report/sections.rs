@@ -6,6 +6,7 @@ use crate::words::{self, capital, duration, num, opt, verdict};
 use serde::Serialize;
 use stiction_core::diagnose::{BandSource, Diagnosis, Verdict, Vote};
 use stiction_core::estimate::IntervalKind;
+use stiction_core::quality::Gate;
 use stiction_core::quantify::{
     FitOutput, LinearFamily, Quantification, QuantifyStatus, ValveStartKind,
 };
@@ -340,7 +341,7 @@ pub fn convergence(q: &Quantification) -> Convergence {
 
 #[derive(Serialize)]
 pub struct GateRow {
-    pub gate: String,
+    pub gate: Gate,
     pub passed: bool,
     pub value: String,
     pub limit: String,
@@ -367,7 +368,7 @@ pub fn quality(d: &Diagnosis) -> Quality {
         .quality
         .iter()
         .map(|f| GateRow {
-            gate: f.gate.clone(),
+            gate: f.gate,
             passed: f.passed,
             value: num(f.value),
             limit: num(f.limit),

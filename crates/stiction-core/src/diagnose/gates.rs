@@ -4,16 +4,16 @@
 
 use super::request::DiagnoseRequest;
 use super::stretch::Excluded;
-use crate::quality::{self, Finding, Record};
+use crate::quality::{self, Finding, Gate, Record};
 
 /// `n` and the noun's singular or plural form: "1 gap", "3 gaps".
 pub(crate) fn plural(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 
-fn finding(gate: &str, passed: bool, value: f64, limit: f64, message: String) -> Finding {
+fn finding(gate: Gate, passed: bool, value: f64, limit: f64, message: String) -> Finding {
     Finding {
-        gate: gate.into(),
+        gate,
         passed,
         value,
         limit,
@@ -32,7 +32,7 @@ pub(super) fn findings(
     let n = r.op.len();
     let used = e - s;
     let mut out = vec![finding(
-        "record_length",
+        Gate::RecordLength,
         used >= req.min_samples,
         used as f64,
         req.min_samples as f64,
@@ -48,19 +48,19 @@ pub(super) fn findings(
     )];
     for (gate, count, what, limit) in [
         (
-            "manual_mode",
+            Gate::ManualMode,
             excluded.manual,
             "in manual",
             req.limits.manual_share,
         ),
         (
-            "missing_values",
+            Gate::MissingValues,
             excluded.missing,
             "with a missing value",
             1.0,
         ),
         (
-            "op_saturated",
+            Gate::OpSaturated,
             excluded.saturated,
             "with OP at a limit (0 %, 100 % or pinned at its extreme)",
             req.limits.saturated_share,
@@ -83,7 +83,7 @@ pub(super) fn findings(
     }
     if excluded.time_breaks > 0 {
         out.push(finding(
-            "time_gaps",
+            Gate::TimeGaps,
             false,
             excluded.time_breaks as f64,
             0.0,
@@ -98,7 +98,7 @@ pub(super) fn findings(
     let unrecorded = quality::unrecorded(pv);
     let share = unrecorded.iter().filter(|&&u| u).count() as f64 / used.max(1) as f64;
     out.push(finding(
-        "pv_compressed",
+        Gate::PvCompressed,
         share <= req.limits.repeated_share,
         share,
         req.limits.repeated_share,
@@ -112,7 +112,7 @@ pub(super) fn findings(
     levels.dedup();
     let per_100 = 100.0 * levels.len() as f64 / used.max(1) as f64;
     out.push(finding(
-        "pv_quantised",
+        Gate::PvQuantised,
         per_100 >= req.limits.levels_per_100 || levels.len() >= 50,
         levels.len() as f64,
         req.limits.levels_per_100,
@@ -124,7 +124,7 @@ pub(super) fn findings(
     if let Some(sp) = r.sp {
         let changes = sp[s..e].windows(2).filter(|w| w[1] != w[0]).count();
         out.push(finding(
-            "setpoint_changes",
+            Gate::SetpointChanges,
             true,
             changes as f64,
             0.0,

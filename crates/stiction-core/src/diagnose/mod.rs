@@ -29,7 +29,7 @@ pub use result::{Band, BandSource, Diagnosis, Index, Oscillation, Verdict, Vote,
 /// `auto`: `true` where the controller is in automatic). Missing values are NaN.
 pub use crate::quality::Record as LoopRecord;
 
-use crate::quality::{self, Finding};
+use crate::quality::{self, Finding, Gate};
 use crate::quantify::{compare_fits, CompareRequest};
 use evidence::Context;
 use oscillation::{constant_setpoint, mean};
@@ -192,7 +192,7 @@ pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, Diag
 fn too_short(quality: &[Finding], used: usize, req: &DiagnoseRequest) -> String {
     let left: Vec<&str> = quality
         .iter()
-        .filter(|f| !f.passed && f.gate != "record_length" && f.gate != "pv_quantised")
+        .filter(|f| !f.passed && !matches!(f.gate, Gate::RecordLength | Gate::PvQuantised))
         .map(|f| f.message.as_str())
         .collect();
     let mut reason = format!(
