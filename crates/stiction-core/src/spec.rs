@@ -62,21 +62,29 @@ fn get(p: &[(String, f64)], name: &str, default: f64) -> f64 {
         .map_or(default, |(_, v)| *v)
 }
 
+/// The settings of a periodic signal: amplitude, period (seconds) and offset.
+fn periodic(rest: &str, what: &str) -> Result<(f64, f64, f64), SpecError> {
+    let p = pairs(rest, what, &["amplitude", "period", "offset"])?;
+    Ok((
+        get(&p, "amplitude", 1.0),
+        get(&p, "period", 10.0),
+        get(&p, "offset", 0.0),
+    ))
+}
+
 /// `KIND:k=v,...` into a signal. Unnamed settings take the defaults shown in `--help`.
 pub fn signal(text: &str, flag: &str) -> Result<Signal, SpecError> {
     let (kind, rest) = text.split_once(':').unwrap_or((text, ""));
     let what = format!("{flag} {text}");
     let kind = kind.trim().to_ascii_lowercase();
     let s = match kind.as_str() {
-        "sine" | "triangle" => {
-            let p = pairs(rest, &what, &["amplitude", "period", "offset"])?;
-            let (amplitude, period, offset) =
-                (get(&p, "amplitude", 1.0), get(&p, "period", 10.0), get(&p, "offset", 0.0));
-            if kind == "sine" {
-                Signal::Sine { amplitude, period, offset }
-            } else {
-                Signal::Triangle { amplitude, period, offset }
-            }
+        "sine" => {
+            let (amplitude, period, offset) = periodic(rest, &what)?;
+            Signal::Sine { amplitude, period, offset }
+        }
+        "triangle" => {
+            let (amplitude, period, offset) = periodic(rest, &what)?;
+            Signal::Triangle { amplitude, period, offset }
         }
         "random-walk" | "random_walk" | "randomwalk" => {
             let p = pairs(rest, &what, &["std", "offset", "seed"])?;

@@ -61,12 +61,13 @@ impl Method {
 impl std::str::FromStr for Method {
     type Err = EstimateError;
     fn from_str(s: &str) -> Result<Self, EstimateError> {
-        let t = s.trim().to_ascii_lowercase().replace('_', "-");
-        let t = if t == "acor" { "aco-r".to_string() } else { t };
-        Method::ALL
-            .into_iter()
-            .find(|m| m.name() == t)
-            .ok_or_else(|| EstimateError::UnknownMethod(s.to_string()))
+        match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
+            "aco" => Ok(Method::Aco),
+            "aco-r" | "acor" => Ok(Method::AcoR),
+            "exact" => Ok(Method::Exact),
+            "grid" => Ok(Method::Grid),
+            _ => Err(EstimateError::UnknownMethod(s.to_string())),
+        }
     }
 }
 
