@@ -14,8 +14,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Vote {
+    /// Evidence for stiction.
     Stiction,
+    /// Evidence against stiction (an oscillation with another cause, or none).
     NoStiction,
+    /// Neither way: too little to go on, or a value between the thresholds.
     Undetermined,
 }
 
@@ -39,7 +42,9 @@ pub struct Regularity {
     pub regularity: f64,
     /// The threshold: r above it means a regular oscillation.
     pub threshold: f64,
+    /// Zero crossings of the autocorrelation used (at most `MAX_CROSSINGS`).
     pub zero_crossings: usize,
+    /// Whether the oscillation is regular: at least two periods and r above the threshold.
     pub oscillating: bool,
 }
 
@@ -136,8 +141,11 @@ pub struct IaeCount {
     pub most_in_window: usize,
     /// The IAE limit 2 a / ω used, in error units x seconds.
     pub iae_limit: f64,
+    /// Exceedances within one supervision window that mean an oscillation.
     pub n_lim: usize,
+    /// The supervision window, seconds.
     pub window: f64,
+    /// Whether `most_in_window` reached `n_lim`.
     pub oscillating: bool,
 }
 
@@ -146,12 +154,19 @@ pub struct IaeCount {
 /// supervision window of `window` seconds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct IaeSettings {
+    /// Acceptable amplitude `a` of the control error, in error units.
     pub amplitude: f64,
+    /// Frequency scale ω, rad/s.
     pub omega: f64,
+    /// Exceedances within one window that mean an oscillation.
     pub n_lim: usize,
+    /// The supervision window, seconds.
     pub window: f64,
 }
 
+/// Hägglund's count on the control `error` sampled every `ts` seconds: the IAE of each half period
+/// (between crossings of the error's mean) against 2 a / ω, and the most exceedances within any
+/// window.
 pub fn iae_count(error: &[f64], ts: f64, s: &IaeSettings) -> IaeCount {
     let limit = 2.0 * s.amplitude / s.omega;
     let mean = error.iter().sum::<f64>() / error.len().max(1) as f64;
@@ -193,16 +208,19 @@ pub fn iae_count(error: &[f64], ts: f64, s: &IaeSettings) -> IaeCount {
 /// Horch's cross-correlation test (self-regulating loops).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CrossCorrelation {
-    /// First zero crossings of the OP-PV cross-correlation on the negative and positive lag side,
-    /// seconds.
+    /// First zero crossing of the OP-PV cross-correlation on the negative lag side, seconds.
     pub tau_left: Option<f64>,
+    /// The same on the positive lag side (pv after op), seconds.
     pub tau_right: Option<f64>,
     /// |τr + τl| / (τr - τl): 0 for an even function (extremum at lag 0), 1 for an odd one (zero
     /// at lag 0).
     pub oddness: Option<f64>,
-    /// Odd (stiction) above `stiction_above`, even (no stiction) below `no_stiction_below`.
+    /// Oddness above this votes stiction (odd: the sticky valve's signature).
     pub stiction_above: f64,
+    /// Oddness below this votes no stiction (even).
     pub no_stiction_below: f64,
+    /// Stiction when oddness is above `stiction_above`, no stiction below `no_stiction_below`,
+    /// undetermined between or without both crossings.
     pub vote: Vote,
 }
 
@@ -296,9 +314,14 @@ pub fn half_cycles(x: &[f64], hysteresis: f64) -> Vec<(usize, usize)> {
 /// A shape index with its vote.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ShapeIndex {
+    /// The index's value (NaN when no half cycle could be fitted).
     pub value: f64,
+    /// Half cycles fitted (those of at least 4 samples).
     pub half_cycles: usize,
+    /// The stiction threshold: the curve-fitting index votes stiction at or above it, the shape
+    /// index above it.
     pub stiction_above: f64,
+    /// A value at or below this votes no stiction.
     pub no_stiction_below: f64,
     /// Undetermined also when there are too few half cycles.
     pub vote: Vote,

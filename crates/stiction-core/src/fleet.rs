@@ -14,10 +14,15 @@ use std::cmp::Ordering;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Outcome {
+    /// The diagnosis found stiction.
     Stiction,
+    /// Diagnosed, but the evidence did not decide.
     Undetermined,
+    /// The diagnosis found no stiction.
     NoStiction,
+    /// The record was too short or too poor to judge.
     InsufficientData,
+    /// The loop could not be read or diagnosed.
     Failed,
 }
 
@@ -63,9 +68,11 @@ impl std::fmt::Display for Outcome {
 /// One loop of the fleet summary (the columns of `stiction batch`'s summary.csv, in order).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Row {
+    /// The loop's identifier (the ranking's last key).
     pub loop_id: String,
     /// Where the loop came from, in words (a path, or a path and line range).
     pub source: String,
+    /// Its outcome.
     pub verdict: Outcome,
     /// The diagnosis' confidence; `None` for a failed loop.
     pub confidence: Option<f64>,
@@ -73,6 +80,7 @@ pub struct Row {
     pub severity: f64,
     /// The stiction band of a `stiction` verdict, % of valve span, and where it comes from.
     pub band_percent_of_span: Option<f64>,
+    /// Where the band comes from.
     pub band_source: Option<BandSource>,
     /// The width of the ellipse fitted to an oscillation's PV-OP plot, % of valve span.
     pub ellipse_percent_of_span: Option<f64>,
@@ -83,6 +91,7 @@ pub struct Row {
     /// Why the verdict is what it is: the diagnosis' reason, else the indices' votes; for a
     /// failed loop the error.
     pub reason: String,
+    /// Samples in the record; `None` for a failed loop.
     pub samples: Option<u64>,
     /// Time the diagnosis took, seconds.
     pub seconds: Option<f64>,
@@ -195,10 +204,15 @@ pub fn rank(rows: &mut [Row]) {
 /// Number of loops per outcome.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
+    /// Loops with a `stiction` verdict.
     pub stiction: usize,
+    /// Loops with an `undetermined` verdict.
     pub undetermined: usize,
+    /// Loops with a `no_stiction` verdict.
     pub no_stiction: usize,
+    /// Loops with an `insufficient_data` verdict.
     pub insufficient_data: usize,
+    /// Loops that could not be read or diagnosed.
     pub failed: usize,
 }
 

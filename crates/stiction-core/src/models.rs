@@ -14,25 +14,39 @@ use std::fmt;
 /// Errors raised when a model or its parameters are not valid.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ModelError {
+    /// A model name that is not one of stenman, he, kano, choudhury.
     #[error("unknown model '{0}'; the models are stenman, he, kano, choudhury")]
     UnknownModel(String),
+    /// A parameter name the model does not have.
     #[error("model {model} has no parameter '{name}'; its parameters are {known}")]
     UnknownParameter {
+        /// The model's name.
         model: &'static str,
+        /// The name given.
         name: String,
+        /// The model's parameter names, comma-separated.
         known: String,
     },
+    /// A parameter the model needs was not given.
     #[error("model {model} needs a value for parameter '{name}' ({description})")]
     MissingParameter {
+        /// The model's name.
         model: &'static str,
+        /// The parameter's name.
         name: &'static str,
+        /// What the parameter is.
         description: &'static str,
     },
+    /// A parameter value out of range.
     #[error("parameter {name} = {value} of model {model} is invalid: {why}")]
     InvalidParameter {
+        /// The model's name.
         model: &'static str,
+        /// The parameter's name.
         name: &'static str,
+        /// The value given.
         value: f64,
+        /// Why it is invalid.
         why: String,
     },
 }
@@ -40,8 +54,11 @@ pub enum ModelError {
 /// One named, bounded parameter of a model.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct ParamSpec {
+    /// The parameter's name as written on a command line (`d`, `fs`, `S`, ...).
     pub name: &'static str,
+    /// Its unit (`% of span`).
     pub unit: &'static str,
+    /// What it is, in words.
     pub description: &'static str,
     /// Smallest valid value.
     pub min: f64,
@@ -100,10 +117,12 @@ pub trait StictionModel: Copy + Send + Sync {
 /// the command. `d` is the stiction band.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Stenman {
+    /// The stiction band, in op's units (normally % of valve span).
     pub d: f64,
 }
 
 impl Stenman {
+    /// Stenman's model with band `d`; an error unless `d` is a finite number >= 0.
     pub fn new(d: f64) -> Result<Self, ModelError> {
         check_nonneg("stenman", "d", d)?;
         Ok(Self { d })
@@ -137,11 +156,14 @@ impl StictionModel for Stenman {
 /// bit for bit, not just up to rounding.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct He {
+    /// The static friction band, in op's units (normally % of valve span).
     pub fs: f64,
+    /// The kinetic friction band, at most `fs`.
     pub fd: f64,
 }
 
 impl He {
+    /// He's model; an error unless both bands are finite numbers >= 0 and `fd <= fs`.
     pub fn new(fs: f64, fd: f64) -> Result<Self, ModelError> {
         check_nonneg("he", "fs", fs)?;
         check_nonneg("he", "fd", fd)?;
@@ -182,11 +204,14 @@ impl StictionModel for He {
 /// The command is clamped to 0..100 first.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Kano {
+    /// Deadband plus stickband S, % of valve span.
     pub s: f64,
+    /// Slip jump J, % of valve span.
     pub j: f64,
 }
 
 impl Kano {
+    /// Kano's model; an error unless S and J are finite numbers >= 0.
     pub fn new(s: f64, j: f64) -> Result<Self, ModelError> {
         check_nonneg("kano", "S", s)?;
         check_nonneg("kano", "J", j)?;
@@ -194,6 +219,7 @@ impl Kano {
     }
 }
 
+/// The state Kano's recursion carries from one sample to the next.
 #[derive(Debug, Clone, Copy)]
 pub struct KanoState {
     du_old: f64,
@@ -264,13 +290,20 @@ impl StictionModel for Kano {
 /// reversals (0 = the published model).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Choudhury {
+    /// Deadband plus stickband S, % of valve span.
     pub s: f64,
+    /// Slip jump J, % of valve span.
     pub j: f64,
+    /// A change of the scaled command per sample at most this large (% of span) counts as no
+    /// motion.
     pub velocity_deadzone: f64,
+    /// The command values of 0 % and 100 % of span.
     pub span: (f64, f64),
 }
 
 impl Choudhury {
+    /// Choudhury's model with the published behaviour (no velocity deadzone, command already in %
+    /// of span); an error unless S and J are finite numbers >= 0.
     pub fn new(s: f64, j: f64) -> Result<Self, ModelError> {
         check_nonneg("choudhury", "S", s)?;
         check_nonneg("choudhury", "J", j)?;
@@ -298,6 +331,7 @@ impl Choudhury {
     }
 }
 
+/// The state Choudhury's recursion carries from one sample to the next.
 #[derive(Debug, Clone, Copy)]
 pub struct ChoudhuryState {
     v_old: f64,
@@ -377,9 +411,13 @@ fn check_nonneg(model: &'static str, name: &'static str, value: f64) -> Result<(
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ModelKind {
+    /// Stenman's one-parameter model (band d).
     Stenman,
+    /// He et al.'s model (static band fs, kinetic band fd).
     He,
+    /// Kano et al.'s model (S, J).
     Kano,
+    /// Choudhury et al.'s model (S, J).
     Choudhury,
 }
 
@@ -424,8 +462,10 @@ const KANO_PARAMS: [ParamSpec; 2] = [
 ];
 
 impl ModelKind {
+    /// Every model.
     pub const ALL: [ModelKind; 4] = [Self::Stenman, Self::He, Self::Kano, Self::Choudhury];
 
+    /// The model's name, as the CLI and serde write it (`stenman`).
     pub fn name(self) -> &'static str {
         match self {
             Self::Stenman => "stenman",
@@ -435,6 +475,7 @@ impl ModelKind {
         }
     }
 
+    /// The model's parameters, in order.
     pub fn params(self) -> &'static [ParamSpec] {
         match self {
             Self::Stenman => &STENMAN_PARAMS,
@@ -443,6 +484,7 @@ impl ModelKind {
         }
     }
 
+    /// Number of parameters.
     pub fn dim(self) -> usize {
         self.params().len()
     }
@@ -459,6 +501,7 @@ impl ModelKind {
             })
     }
 
+    /// The parameters' names, in order.
     pub fn param_names(self) -> Vec<&'static str> {
         self.params().iter().map(|p| p.name).collect()
     }
@@ -508,21 +551,29 @@ impl std::str::FromStr for ModelKind {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "model", rename_all = "lowercase")]
 pub enum Model {
+    /// Stenman's model.
     Stenman(Stenman),
+    /// He et al.'s model.
     He(He),
+    /// Kano et al.'s model.
     Kano(Kano),
+    /// Choudhury et al.'s model.
     Choudhury(Choudhury),
 }
 
 /// Run-time state of any model, for stepping a [`Model`] in a control loop.
 #[derive(Debug, Clone, Copy)]
 pub enum ModelState {
+    /// Stenman's and He's state: the valve position.
     Position(f64),
+    /// Kano's state.
     Kano(KanoState),
+    /// Choudhury's state.
     Choudhury(ChoudhuryState),
 }
 
 impl Model {
+    /// Which model this is.
     pub fn kind(&self) -> ModelKind {
         match self {
             Model::Stenman(_) => ModelKind::Stenman,
@@ -532,6 +583,7 @@ impl Model {
         }
     }
 
+    /// The parameter values, in the order of [`ModelKind::params`].
     pub fn values(&self) -> Vec<f64> {
         match *self {
             Model::Stenman(m) => vec![m.d],
@@ -551,6 +603,7 @@ impl Model {
         }
     }
 
+    /// Simulate the valve position (mv) for the command `op`.
     pub fn simulate(&self, op: &[f64]) -> Vec<f64> {
         let mut mv = vec![0.0; op.len()];
         self.simulate_into(op, &mut mv);
@@ -578,12 +631,14 @@ impl Model {
         }
     }
 
+    /// As [`Model::simulate_from_into`], into a new vector.
     pub fn simulate_from(&self, op: &[f64], start: Option<f64>) -> Vec<f64> {
         let mut mv = vec![0.0; op.len()];
         self.simulate_from_into(op, start, &mut mv);
         mv
     }
 
+    /// Sum of squared errors between a measured valve position and this model's output.
     pub fn sse(&self, op: &[f64], mv_measured: &[f64]) -> f64 {
         match self {
             Model::Stenman(m) => m.sse(op, mv_measured),
@@ -615,6 +670,8 @@ impl Model {
         }
     }
 
+    /// Advance one sample with command `u`; returns the valve position. Panics if `state` belongs
+    /// to another model.
     pub fn step(&self, state: &mut ModelState, u: f64) -> f64 {
         match (self, state) {
             (Model::Stenman(m), ModelState::Position(s)) => m.step(s, u),

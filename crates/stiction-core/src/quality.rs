@@ -1,5 +1,5 @@
 //! Data-quality gates: before any verdict on a loop, check the record can carry one. A failed gate
-//! means "insufficient data: <reason>", never a false "no stiction".
+//! means "insufficient data" with its reason, never a false "no stiction".
 
 use serde::{Deserialize, Serialize};
 
@@ -100,8 +100,11 @@ impl Default for Limits {
 /// The signals a loop record may have.
 #[derive(Debug, Clone, Copy)]
 pub struct Record<'a> {
+    /// The controller output (op): the valve's command, normally % of valve span.
     pub op: &'a [f64],
+    /// The process variable (pv).
     pub pv: &'a [f64],
+    /// The setpoint (sp), when recorded.
     pub sp: Option<&'a [f64]>,
     /// The recorded valve position, when there is one.
     pub mv: Option<&'a [f64]>,

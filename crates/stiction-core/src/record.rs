@@ -13,11 +13,17 @@ use std::borrow::Cow;
 /// automatic; `time` in seconds).
 #[derive(Debug, Clone)]
 pub struct Signals<'a> {
+    /// The controller output (op), normally % of valve span.
     pub op: Cow<'a, [f64]>,
+    /// The process variable (pv).
     pub pv: Cow<'a, [f64]>,
+    /// The setpoint (sp), when recorded.
     pub sp: Option<Cow<'a, [f64]>>,
+    /// The recorded valve position (mv), when recorded.
     pub mv: Option<Cow<'a, [f64]>>,
+    /// The controller mode, `true` in automatic, when recorded.
     pub auto: Option<Cow<'a, [bool]>>,
+    /// Time of each sample, seconds, when recorded.
     pub time: Option<Cow<'a, [f64]>>,
 }
 
@@ -51,6 +57,7 @@ impl<'a> Signals<'a> {
 /// decided on the way.
 #[derive(Debug, Clone)]
 pub struct Prepared<'a> {
+    /// The signals, in time order.
     pub signals: Signals<'a>,
     /// Sampling time, seconds.
     pub ts: f64,
@@ -63,14 +70,20 @@ pub struct Prepared<'a> {
 /// Why a record cannot be prepared.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PrepareError {
+    /// The sampling time (seconds) given is not a positive number.
     #[error("the sampling time must be a positive number of seconds, got {0}")]
     Ts(f64),
+    /// The time column does not increase, so no sampling time follows from it.
     #[error("the time column does not increase; give the sampling time")]
     TimeNotIncreasing,
+    /// A signal's length differs from OP's.
     #[error("{signal} has {len} samples but op has {op}: the signals must have the same length")]
     Length {
+        /// Which signal (`pv`, `sp`, `mv`, `mode` or `time`).
         signal: &'static str,
+        /// Its samples.
         len: usize,
+        /// Samples of OP.
         op: usize,
     },
 }

@@ -13,12 +13,19 @@ use serde::{Deserialize, Serialize};
 /// The paper's Table 2: (true d, the paper's estimate).
 pub const PAPER_TABLE_2: [(f64, f64); 2] = [(0.2, 0.2), (0.5, 0.48)];
 
+/// How the paper's open-loop cases are reproduced: the command, its sampling, the seeds and the ACO
+/// settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PaperSetup {
+    /// The command driving the valve (a unit sine of period 10 s by default).
     pub signal: Signal,
+    /// Sampling time, seconds.
     pub ts: f64,
+    /// Samples simulated.
     pub samples: usize,
+    /// Seeds of the ACO runs, one run each.
     pub seeds: Vec<u64>,
+    /// The ACO settings (the paper's).
     pub aco: AcoSettings,
     /// Search range of d (the paper: from 0.01 up to 10).
     pub bounds: (f64, f64),
@@ -41,29 +48,38 @@ impl Default for PaperSetup {
     }
 }
 
+/// One case of Table 2: a true d, the exact optimal set, and the ACO runs against it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PaperCase {
+    /// The band d the valve was simulated with, in op's units.
     pub true_d: f64,
+    /// The paper's estimate of d for this case.
     pub paper_estimate: f64,
     /// Hull of the exact optimal set of d.
     pub interval: [f64; 2],
     /// The exact optimal set as half-open pieces [lo, hi).
     pub pieces: Vec<[f64; 2]>,
+    /// The least fit error (sum of squares), that of every d in the optimal set.
     pub optimal_sse: f64,
+    /// The seeds run.
     pub seeds: Vec<u64>,
     /// The ACO estimate per seed.
     pub estimates: Vec<f64>,
     /// The fit error of each seed's estimate.
     pub sse: Vec<f64>,
+    /// Mean of the ACO estimates.
     pub mean: f64,
     /// The estimate farthest from the true d.
     pub worst: f64,
     /// Seeds whose estimate lies in the exact optimal set.
     pub inside: usize,
+    /// Whether the true d lies in the exact optimal set.
     pub true_d_inside: bool,
+    /// Whether the paper's estimate lies in the exact optimal set.
     pub paper_estimate_inside: bool,
     /// Mean time per ACO run, seconds.
     pub seconds_per_run: f64,
+    /// The simulated data (op, mv).
     #[serde(skip)]
     pub data: LoopData,
     /// Convergence trace per seed (for the figures).
@@ -71,12 +87,16 @@ pub struct PaperCase {
     pub traces: Vec<Vec<TraceRow>>,
 }
 
+/// The reproduction: the setup and one case per row of Table 2.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PaperReproduction {
+    /// The setup used.
     pub setup: PaperSetup,
+    /// One case per row of Table 2.
     pub cases: Vec<PaperCase>,
 }
 
+/// Run every case of Table 2 with `setup`.
 pub fn reproduce_paper(setup: &PaperSetup) -> PaperReproduction {
     let cases = PAPER_TABLE_2
         .iter()

@@ -3,6 +3,7 @@
 use rand::{RngExt, SeedableRng};
 pub use rand_xoshiro::Xoshiro256PlusPlus as Rng;
 
+/// The generator seeded with `seed`: the same seed gives the same stream on every platform.
 pub fn seeded(seed: u64) -> Rng {
     Rng::seed_from_u64(seed)
 }

@@ -32,6 +32,7 @@ pub enum Stability {
 /// The health of a simulated closed loop.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LoopHealth {
+    /// Whether the loop is stable, growing or running away.
     pub stability: Stability,
     /// RMS of the control error (sp - pv) in the last quarter over that in the second quarter
     /// (`None` when either is not finite or the second is 0).

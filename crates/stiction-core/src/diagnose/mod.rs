@@ -3,12 +3,12 @@
 //! the best excitation a loop gets), then independent families of evidence, each with its value,
 //! threshold and vote, and a verdict that says why.
 //!
-//! - [`stretch`] and [`gates`]: the usable stretches and the data-quality findings;
+//! - `stretch` and `gates`: the usable stretches and the data-quality findings;
 //! - [`oscillation`]: does the loop oscillate (for the shape family);
 //! - [`evidence`]: the families (shape, model, stick-slip, valve), one file each behind a trait;
-//! - [`verdict`]: families that agree decide, families that conflict give `undetermined`;
-//! - [`band`]: when the verdict is `stiction`, the band in % of valve span and where it comes from;
-//! - [`windows`]: the same judgement per window of the record.
+//! - `verdict`: families that agree decide, families that conflict give `undetermined`;
+//! - `band`: when the verdict is `stiction`, the band in % of valve span and where it comes from;
+//! - `windows`: the same judgement per window of the record.
 
 mod band;
 pub mod evidence;

@@ -10,6 +10,7 @@ pub struct DiagnoseRequest {
     pub ts: f64,
     /// A level-type (integrating) process: the indices and the fits use their integrating variants.
     pub integrating: bool,
+    /// The data-quality gates' limits.
     pub limits: Limits,
     /// Fewest oscillation periods for the shape indices to judge an oscillation.
     pub min_periods: f64,
@@ -65,20 +66,43 @@ impl DiagnoseRequest {
 /// is `insufficient_data`, and missing values are gaps).
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum DiagnoseError {
+    /// OP and PV differ in length.
     #[error("op has {op} samples but pv has {pv}: the signals must have the same length")]
-    Lengths { op: usize, pv: usize },
+    Lengths {
+        /// Samples of OP.
+        op: usize,
+        /// Samples of PV.
+        pv: usize,
+    },
+    /// SP, MV, time or the mode differs in length from OP.
     #[error("{signal} has {len} samples but op has {op}: the signals must have the same length")]
     OtherLength {
+        /// Which signal (`sp`, `mv`, `time` or `mode`).
         signal: &'static str,
+        /// Its samples.
         len: usize,
+        /// Samples of OP.
         op: usize,
     },
+    /// The sampling time (seconds) is not a positive number.
     #[error("the sampling time must be a positive number of seconds, got {0}")]
     Ts(f64),
+    /// The verdict window is too short.
     #[error("a window of {window} samples is too short: a window needs at least {least}")]
-    Window { window: usize, least: usize },
+    Window {
+        /// The window asked for, samples.
+        window: usize,
+        /// The shortest window allowed, samples.
+        least: usize,
+    },
+    /// The OP range of a closed and a fully open valve is empty or reversed.
     #[error("the OP range [{lo}, {hi}] is empty: the value of a fully open valve must exceed that of a closed one")]
-    OpRange { lo: f64, hi: f64 },
+    OpRange {
+        /// OP of a closed valve.
+        lo: f64,
+        /// OP of a fully open valve.
+        hi: f64,
+    },
 }
 
 pub(super) fn check(r: &Record, req: &DiagnoseRequest) -> Result<(), DiagnoseError> {

@@ -12,13 +12,19 @@ pub use crate::detect::Vote;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
+    /// The valve sticks: the families that decided agree on stiction.
     Stiction,
+    /// The valve does not stick: the record shows no stiction (healthy, or another cause of the
+    /// oscillation).
     NoStiction,
+    /// The record was judged but the evidence is too weak or conflicting to decide.
     Undetermined,
+    /// The record cannot be judged: too short, or too little usable data (see the reason).
     InsufficientData,
 }
 
 impl Verdict {
+    /// The name used in files (`no_stiction`), as serde writes it.
     pub fn as_str(self) -> &'static str {
         match self {
             Verdict::Stiction => "stiction",
@@ -43,9 +49,11 @@ pub struct Index {
     pub name: String,
     /// Where the method and its threshold come from.
     pub reference: String,
+    /// The index's value (`None` when it could not be computed).
     pub value: Option<f64>,
     /// The rule, in words, e.g. "stiction above 0.667, none below 0.333".
     pub threshold: String,
+    /// Its vote.
     pub vote: Vote,
     /// Its weight in the shape family's vote.
     pub weight: f64,
@@ -62,12 +70,16 @@ pub struct Index {
 /// Is there an oscillation, and of what period?
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Oscillation {
+    /// Whether the control error oscillates: a regular period (with at least 4 IAE exceedances) or
+    /// Hägglund's count, with an amplitude that stands out of the noise.
     pub oscillating: bool,
     /// Seconds.
     pub period: Option<f64>,
     /// Stretch length over the period.
     pub periods_in_record: Option<f64>,
+    /// Thornhill's regularity of the control error.
     pub regularity: Regularity,
+    /// Hägglund's IAE count on the control error.
     pub iae: IaeCount,
     /// Standard deviation of the noise on the control error (robust, from first differences).
     pub noise_std: f64,
@@ -131,6 +143,7 @@ pub struct Band {
     /// The values that fit equally well, % of span, where the source knows them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interval_percent_of_span: Option<[f64; 2]>,
+    /// Where the band comes from.
     pub source: BandSource,
     /// The other estimates, % of span, for comparison.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -146,14 +159,20 @@ pub struct Band {
 pub struct WindowVerdict {
     /// Sample range `[start, end)` in the whole record.
     pub start: usize,
+    /// End of the sample range (exclusive).
     pub end: usize,
     /// Time of the first and last sample, seconds.
     pub t_start: f64,
+    /// Time of the last sample, seconds.
     pub t_end: f64,
+    /// The window's verdict.
     pub verdict: Verdict,
+    /// 0..1, for `stiction` and `no_stiction` only (as [`Diagnosis::confidence`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub confidence: Option<f64>,
+    /// For `insufficient_data` and `undetermined`: the reason.
     pub reason: Option<String>,
+    /// The oscillation period, seconds, when the window oscillates.
     pub period: Option<f64>,
     /// Each family's vote.
     pub votes: Vec<(super::evidence::Family, Vote)>,
@@ -162,6 +181,7 @@ pub struct WindowVerdict {
 /// The diagnosis of one loop.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Diagnosis {
+    /// The answer for the loop.
     pub verdict: Verdict,
     /// 0..1, for `stiction` and `no_stiction` only: how strongly the families that decided agree.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -174,14 +194,18 @@ pub struct Diagnosis {
     pub evidence: Vec<String>,
     /// What to do next, in one line.
     pub next_step: String,
+    /// Samples in the record.
     pub samples: usize,
     /// The analysed stretch `[start, end)`: the longest stretch in automatic with usable data
     /// (setpoint changes are kept: they excite the loop).
     pub analysed: [usize; 2],
     /// Every usable stretch, the analysed one among them.
     pub stretches: Vec<[usize; 2]>,
+    /// Sampling time, seconds.
     pub ts: f64,
+    /// The data-quality gates' findings.
     pub quality: Vec<Finding>,
+    /// The oscillation on the analysed stretch (absent when the record is too short to judge).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub oscillation: Option<Oscillation>,
     /// The families of evidence, each with its value, threshold and vote.
@@ -197,8 +221,11 @@ pub struct Diagnosis {
     /// The samples `[start, end)` the closed-loop estimate used.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub quantified: Option<[usize; 2]>,
+    /// A verdict per window, when the request asks for windows.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub windows: Vec<WindowVerdict>,
+    /// What the diagnosis had to assume (e.g. no setpoint recorded).
     pub warnings: Vec<String>,
+    /// Time the diagnosis took, seconds.
     pub seconds: f64,
 }

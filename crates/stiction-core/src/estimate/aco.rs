@@ -21,9 +21,12 @@ use crate::rng::Rng;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
+/// Settings of the paper's ACO (Ant System on a grid of nodes).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AcoSettings {
+    /// Ants per iteration.
     pub ants: usize,
+    /// Iterations.
     pub iterations: usize,
     /// Evaporation rate rho.
     pub rho: f64,
@@ -60,6 +63,7 @@ impl Default for AcoSettings {
     }
 }
 
+/// The paper's ACO as a [`Solver`]: a pheromone vector over each parameter's grid of nodes.
 pub struct PaperAco {
     settings: AcoSettings,
     kind: ModelKind,
@@ -80,6 +84,8 @@ pub struct PaperAco {
 }
 
 impl PaperAco {
+    /// A colony over `bounds` (one `(lo, hi)` per parameter of `kind`, in the model's parameter
+    /// order), with uniform pheromone `tau0` on every node.
     pub fn new(settings: AcoSettings, kind: ModelKind, bounds: &[(f64, f64)]) -> Self {
         let nodes: Vec<Vec<f64>> = bounds
             .iter()

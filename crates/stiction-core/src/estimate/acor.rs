@@ -11,12 +11,14 @@ use crate::rng::{gaussian, Rng};
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
+/// Settings of ACO_R.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AcorSettings {
     /// Archive size k.
     pub archive: usize,
     /// New solutions per iteration m.
     pub ants: usize,
+    /// Iterations.
     pub iterations: usize,
     /// Locality of the search q (small: greedy around the best).
     pub q: f64,
@@ -38,6 +40,7 @@ impl Default for AcorSettings {
     }
 }
 
+/// ACO_R as a [`Solver`]: an archive of the best solutions and Gaussian kernels around them.
 pub struct Acor {
     settings: AcorSettings,
     kind: ModelKind,
@@ -54,6 +57,8 @@ pub struct Acor {
 }
 
 impl Acor {
+    /// A solver over `bounds` (one `(lo, hi)` per parameter of `kind`, in the model's parameter
+    /// order); an archive below 2 is raised to 2.
     pub fn new(settings: AcorSettings, kind: ModelKind, bounds: &[(f64, f64)]) -> Self {
         let k = settings.archive.max(2);
         let q = settings.q;

@@ -16,6 +16,7 @@ use super::objective::Objective;
 use crate::models::ModelKind;
 use serde::{Deserialize, Serialize};
 
+/// Settings of the exact Stenman solver's initial bound.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ExactSettings {
     /// Points of the grid whose best cost is the initial bound.
@@ -38,6 +39,7 @@ impl Default for ExactSettings {
 pub struct ExactSolution {
     /// Disjoint half-open pieces `[lo, hi)` whose union is the optimal set, sorted.
     pub pieces: Vec<(f64, f64)>,
+    /// Fit error (sum of squares) of every d in the optimal set.
     pub sse: f64,
     /// Largest number of live cells at any step.
     pub cells_peak: usize,

@@ -3,6 +3,7 @@
 use super::objective::Objective;
 use serde::{Deserialize, Serialize};
 
+/// Settings of the grid search.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GridSettings {
     /// Points per parameter, ends included (a two-parameter model evaluates points^2 candidates).
@@ -15,14 +16,20 @@ impl Default for GridSettings {
     }
 }
 
+/// What the grid search found.
 pub struct GridResult {
+    /// The best grid point, one value per parameter.
     pub best: Vec<f64>,
+    /// Its fit error (sum of squares).
     pub sse: f64,
     /// Per parameter, the hull of the grid points whose cost equals the minimum.
     pub minimisers_hull: Vec<(f64, f64)>,
+    /// Candidates evaluated.
     pub evaluations: u64,
 }
 
+/// Evaluate every point of a grid over `bounds` (one `(lo, hi)` per parameter; two-parameter grids
+/// capped at 400 points per axis) and return the best.
 pub fn search(obj: &Objective, bounds: &[(f64, f64)], settings: &GridSettings) -> GridResult {
     let dim = bounds.len();
     // two-parameter grids are points^2: cap the default so a plain `--method grid` stays quick

@@ -37,8 +37,10 @@ pub enum Method {
 }
 
 impl Method {
+    /// Every method.
     pub const ALL: [Method; 4] = [Method::Aco, Method::AcoR, Method::Exact, Method::Grid];
 
+    /// The method's name as the CLI and serde write it (`aco-r`).
     pub fn name(self) -> &'static str {
         match self {
             Method::Aco => "aco",
@@ -77,23 +79,35 @@ impl std::fmt::Display for Method {
     }
 }
 
+/// Errors in an estimation request or its data.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EstimateError {
+    /// A method name that is not one of aco, aco-r, exact, grid.
     #[error("unknown method '{0}'; the methods are aco, aco-r, exact, grid")]
     UnknownMethod(String),
+    /// The exact method asked for another model than Stenman.
     #[error("the exact method solves the Stenman model only; for {0} use aco-r, aco or grid")]
     ExactNeedsStenman(ModelKind),
+    /// An invalid model parameter.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// A search range that cannot be searched.
     #[error("bounds for {name} are [{lo}, {hi}]: {why}")]
     Bounds {
+        /// The parameter.
         name: String,
+        /// Its lower end.
         lo: f64,
+        /// Its upper end.
         hi: f64,
+        /// What is wrong with it.
         why: &'static str,
     },
+    /// A method's settings out of range.
     #[error("{0}")]
     Settings(String),
+    /// Data that cannot be estimated from (lengths, non-finite values, too few samples, a constant
+    /// command).
     #[error("{0}")]
     Data(String),
 }
@@ -101,14 +115,21 @@ pub enum EstimateError {
 /// What to estimate and how.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Request {
+    /// The stiction model to fit.
     pub model: ModelKind,
+    /// The search method.
     pub method: Method,
     /// Search range per parameter, in the model's parameter order; `None` uses the model's defaults.
     pub bounds: Option<Vec<(f64, f64)>>,
+    /// Seed of the random searches (aco, aco-r).
     pub seed: u64,
+    /// Settings of the paper's ACO.
     pub aco: AcoSettings,
+    /// Settings of ACO_R.
     pub acor: AcorSettings,
+    /// Settings of the grid search.
     pub grid: GridSettings,
+    /// Settings of the exact solver's initial bound.
     pub exact: ExactSettings,
     /// Keep the per-iteration trace (population methods).
     pub trace: bool,
@@ -118,6 +139,7 @@ pub struct Request {
 }
 
 impl Request {
+    /// A request for `model` by `method` with every setting at its default (seed 1, certified).
     pub fn new(model: ModelKind, method: Method) -> Self {
         Self {
             model,
@@ -222,7 +244,9 @@ pub enum IntervalKind {
 /// The result of an estimation, shared by every front end.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Estimate {
+    /// The model fitted.
     pub model: ModelKind,
+    /// The method used.
     pub method: Method,
     /// Point estimate per parameter.
     pub params: BTreeMap<String, f64>,
@@ -240,20 +264,26 @@ pub struct Estimate {
     pub rmse: f64,
     /// Fit quality 1 - SSE / sum (mv - mean)^2.
     pub r2: f64,
+    /// Objective evaluations (for the exact method, those of its initial bound).
     pub evaluations: u64,
     /// Iterations run (population methods), cells created (exact), 1 (grid).
     pub iterations: u64,
     /// Time spent estimating, excluding reading the data.
     pub seconds: f64,
+    /// Samples fitted.
     pub samples: usize,
     /// Search range per parameter.
     pub bounds: BTreeMap<String, [f64; 2]>,
+    /// The seed used (random searches only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
     /// Stenman with a non-exact method: the proven optimal set, and whether the estimate is in it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub certificate: Option<Certificate>,
+    /// Caveats: a wide optimal set, an estimate outside the proven optimum, a parameter on its
+    /// bound.
     pub warnings: Vec<String>,
+    /// The per-iteration trace, when requested (population methods).
     #[serde(skip_serializing_if = "Vec::is_empty", default)]
     pub trace: Vec<TraceRow>,
 }
@@ -261,8 +291,11 @@ pub struct Estimate {
 /// A check of a heuristic's answer against the exact optimum (Stenman only).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Certificate {
+    /// The hull of the proven optimal set of d, `[lo, hi]`.
     pub optimal_interval: [f64; 2],
+    /// The least fit error (sum of squares).
     pub optimal_sse: f64,
+    /// Whether the heuristic's d lies in the optimal set.
     pub estimate_is_optimal: bool,
 }
 

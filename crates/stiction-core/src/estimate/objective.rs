@@ -1,4 +1,5 @@
-//! The fit objective F(θ) = Σ (mv[t] - x_θ[t])², evaluated for many candidates per pass over the data.
+//! The fit objective `F(θ) = Σ (mv[t] - x_θ[t])²`, evaluated for many candidates per pass over the
+//! data.
 //!
 //! The recursion is sequential in time but independent across candidates, so candidates are taken
 //! in groups of [`LANES`]: one pass over the samples advances every member of the group (the inner
@@ -20,6 +21,7 @@ const PARALLEL_WORK: usize = 1 << 21;
 
 /// Build a model from already repaired parameter values (no validation: the hot path).
 pub trait FromValues: StictionModel {
+    /// The model with parameters `v`, in the model's parameter order.
     fn from_values(v: &[f64]) -> Self;
 }
 
@@ -56,17 +58,22 @@ impl FromValues for Choudhury {
 /// The objective for one data set: a command `op` and a measured valve position `mv`.
 #[derive(Debug, Clone, Copy)]
 pub struct Objective<'a> {
+    /// The stiction model fitted.
     pub kind: ModelKind,
+    /// The command (op).
     pub op: &'a [f64],
+    /// The measured valve position (mv), in op's units.
     pub mv: &'a [f64],
 }
 
 impl<'a> Objective<'a> {
+    /// The objective for `kind` on `op` and `mv`; panics when their lengths differ.
     pub fn new(kind: ModelKind, op: &'a [f64], mv: &'a [f64]) -> Self {
         assert_eq!(op.len(), mv.len(), "op and mv must have the same length");
         Self { kind, op, mv }
     }
 
+    /// Parameters per candidate.
     pub fn dim(&self) -> usize {
         self.kind.dim()
     }

@@ -1,5 +1,5 @@
 //! The pieces every population solver shares, in the shape of argmin: the problem (an
-//! [`Objective`] behind an [`Evaluator`] that counts evaluations and keeps the best), the solver
+//! [`Objective`](super::Objective) behind an [`Evaluator`] that counts evaluations and keeps the best), the solver
 //! (one `next_iter` at a time), the executor ([`run`]: budget and seed) and observers (the
 //! per-iteration trace the paper plots).
 
@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 /// A cost to minimise over a box of parameters, evaluated a whole population at a time (the one
 /// place where batching and threads live).
 pub trait CostFunction: Sync {
+    /// Parameters per candidate.
     fn dim(&self) -> usize;
     /// Costs of `candidates` (flat, `dim` values each) into `costs`.
     fn eval_batch(&self, candidates: &[f64], costs: &mut [f64]);
@@ -32,6 +33,7 @@ pub struct Evaluator<'a> {
 }
 
 impl<'a> Evaluator<'a> {
+    /// Wraps `objective`, with no evaluation and no best yet.
     pub fn new(objective: &'a dyn CostFunction) -> Self {
         Self {
             best: vec![f64::NAN; objective.dim()],
@@ -41,6 +43,7 @@ impl<'a> Evaluator<'a> {
         }
     }
 
+    /// Parameters per candidate.
     pub fn dim(&self) -> usize {
         self.objective.dim()
     }
@@ -61,12 +64,15 @@ impl<'a> Evaluator<'a> {
         }
     }
 
+    /// Candidates evaluated so far.
     pub fn evaluations(&self) -> u64 {
         self.evaluations
     }
+    /// The best candidate so far (NaN before the first evaluation).
     pub fn best(&self) -> &[f64] {
         &self.best
     }
+    /// The best candidate's cost (infinity before the first evaluation).
     pub fn best_cost(&self) -> f64 {
         self.best_cost
     }
@@ -75,24 +81,34 @@ impl<'a> Evaluator<'a> {
 /// What one iteration found.
 #[derive(Debug, Clone)]
 pub struct IterationBest {
+    /// The iteration's best parameters.
     pub params: Vec<f64>,
+    /// Their cost.
     pub cost: f64,
 }
 
 /// A population solver: `init` then repeated `next_iter`.
 pub trait Solver {
+    /// Set up the first population.
     fn init(&mut self, ev: &mut Evaluator, rng: &mut Rng);
+    /// Run one iteration and return its best.
     fn next_iter(&mut self, ev: &mut Evaluator, rng: &mut Rng) -> IterationBest;
 }
 
 /// One row of the convergence trace: per iteration, the best so far and the iteration's best.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TraceRow {
+    /// Iteration, from 1.
     pub iteration: usize,
+    /// The best parameters so far.
     pub best: Vec<f64>,
+    /// Their fit error (sum of squares).
     pub best_sse: f64,
+    /// The iteration's best parameters.
     pub iteration_best: Vec<f64>,
+    /// Their fit error (sum of squares).
     pub iteration_best_sse: f64,
+    /// Evaluations so far.
     pub evaluations: u64,
 }
 

@@ -1,7 +1,9 @@
 //! Linear identification of the process from the valve position to the PV: ARX models fitted by
 //! least squares, orders and delay chosen by an information criterion, and output-error simulation.
 //!
-//!   y[t] = a_1 y[t-1] + ... + a_na y[t-na] + b_0 mv[t-nk] + ... + b_{nb-1} mv[t-nk-nb+1] + c
+//! ```text
+//! y[t] = a_1 y[t-1] + ... + a_na y[t-na] + b_0 mv[t-nk] + ... + b_{nb-1} mv[t-nk-nb+1] + c
+//! ```
 //!
 //! For a self-regulating process `y` is the PV; for an integrating one (level loops) it is the PV's
 //! change `pv[t] - pv[t-1]`. Both are centred first (the constant `c` takes up the rest), which keeps
@@ -30,9 +32,13 @@ use simulate::*;
 /// Which linear structure: family, orders and delay (in samples, `nk >= 1`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Structure {
+    /// Integrating (the output is the PV's change per sample) rather than self-regulating (the PV).
     pub integrating: bool,
+    /// Output lags na (the a coefficients).
     pub na: usize,
+    /// Input terms nb (the b coefficients).
     pub nb: usize,
+    /// Delay nk, samples (at least 1).
     pub nk: usize,
 }
 
@@ -41,14 +47,19 @@ pub struct Structure {
 pub struct SearchRange {
     /// Orders of the output lags tried for self-regulating processes (integrating: `na - 1`).
     pub na: Vec<usize>,
+    /// Largest number of input terms tried.
     pub nb_max: usize,
+    /// Largest delay tried, samples.
     pub nk_max: usize,
     /// Try self-regulating structures, integrating ones, or both.
     pub self_regulating: bool,
+    /// Try integrating structures.
     pub integrating: bool,
 }
 
 impl SearchRange {
+    /// The default range (na 1 and 2, nb up to 2, both families) with delays up to `nk_max` samples
+    /// (at least 1).
     pub fn new(nk_max: usize) -> Self {
         Self {
             na: vec![1, 2],
@@ -95,7 +106,9 @@ impl SearchRange {
 
 /// The signals prepared once: centred output for each family and centred valve position.
 pub struct Data<'a> {
+    /// The PV as recorded.
     pub pv: &'a [f64],
+    /// First sample index the fits use (see [`SearchRange::t0`]).
     pub t0: usize,
     y_level: Vec<f64>,
     y_diff: Vec<f64>,
@@ -106,6 +119,7 @@ pub struct Data<'a> {
 }
 
 impl<'a> Data<'a> {
+    /// Centre the PV and its change per sample, for fits from sample `t0` on.
     pub fn new(pv: &'a [f64], t0: usize) -> Self {
         let n = pv.len();
         let mean_level = pv.iter().sum::<f64>() / n as f64;
@@ -153,8 +167,11 @@ impl<'a> Data<'a> {
 /// A fitted ARX model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Fit {
+    /// The structure fitted.
     pub structure: Structure,
+    /// Output coefficients a_1 .. a_na.
     pub a: Vec<f64>,
+    /// Input coefficients b_0 .. b_{nb-1}.
     pub b: Vec<f64>,
     /// Constant, in the units of the centred output.
     pub c: f64,
@@ -179,9 +196,11 @@ impl Fit {
         }
     }
 
+    /// R² of the one-step prediction.
     pub fn r2_one_step(&self) -> f64 {
         1.0 - self.sse_one_step / self.sst
     }
+    /// R² of the simulation (output error).
     pub fn r2_simulation(&self) -> f64 {
         1.0 - self.sse_simulation / self.sst
     }

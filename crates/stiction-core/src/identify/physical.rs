@@ -15,6 +15,7 @@ pub struct Physical {
     pub dead_time: f64,
 }
 
+/// Gain, time constant and dead time of `f`, for sampling time `ts` seconds.
 pub fn physical(f: &Fit, ts: f64) -> Physical {
     let s = f.structure;
     let sum_a: f64 = f.a.iter().sum();

@@ -30,6 +30,7 @@ pub struct Prepared<'a> {
 }
 
 impl<'a> Prepared<'a> {
+    /// The PV's sums for structure `s` (at most 2 output lags and 2 input terms; panics otherwise).
     pub fn new(data: &'a Data, s: Structure) -> Self {
         assert!(s.na <= 2 && s.nb <= 2 && s.nk >= 1);
         let y = data.y(s.integrating);
@@ -62,6 +63,7 @@ impl<'a> Prepared<'a> {
         }
     }
 
+    /// The structure these sums are for.
     pub fn structure(&self) -> Structure {
         self.s
     }

@@ -184,7 +184,9 @@ pub fn select(data: &Data, mv: &[f64], range: &SearchRange) -> Option<Selection>
 /// What `select` chose, with both criteria.
 #[derive(Debug, Clone, Copy)]
 pub struct Selection {
+    /// The chosen structure.
     pub structure: Structure,
+    /// BIC of its simulation error.
     pub simulation_bic: f64,
     /// The family's best one-step BIC (comparable across families).
     pub one_step_bic: f64,

@@ -1,6 +1,8 @@
 //! The controller from routine data: a PI in velocity form,
 //!
-//!   op[t] - op[t-1] = Kc (e[t] - e[t-1]) + Kc Ts / Ti e[t] + c,
+//! ```text
+//! op[t] - op[t-1] = Kc (e[t] - e[t-1]) + Kc Ts / Ti e[t] + c,
+//! ```
 //!
 //! fitted by least squares on the OP increments (the constant `c` takes up a setpoint that is not
 //! recorded, when the error is the PV's deviation from its mean). The velocity form is the one
@@ -39,6 +41,7 @@ pub struct PiFit {
     pub ki: f64,
     /// Integral time in seconds, when the integral gain has Kc's sign.
     pub ti: Option<f64>,
+    /// Reverse or direct action (the sign of Kc).
     pub action: Action,
     /// Samples by which the error leads OP (0 or 1).
     pub lag: usize,

@@ -93,6 +93,7 @@ pub const SLIP_RATIOS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
 /// A valve's describing function along a grid of amplitude over band.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ValveLocus {
+    /// The valve model (Kano or Stenman).
     pub kind: ModelKind,
     /// Kano's J / S (1 for Stenman).
     pub slip_ratio: f64,
@@ -131,10 +132,13 @@ pub fn valve_loci(samples_per_period: f64) -> Vec<ValveLocus> {
 /// The valve describing function nearest a target.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Nearest {
+    /// The valve model (Kano or Stenman).
     pub kind: ModelKind,
+    /// Kano's J / S (1 for Stenman).
     pub slip_ratio: f64,
     /// Amplitude over band there.
     pub ratio: f64,
+    /// The describing function there (complex gain).
     pub n: Complex64,
     /// Distance from the target.
     pub distance: f64,

@@ -47,7 +47,9 @@ pub fn pi_response(pi: &PiFit, theta: f64) -> Complex64 {
 /// The identified open loop: process and PI.
 #[derive(Debug, Clone)]
 pub struct OpenLoop<'a> {
+    /// The identified process (ARX, from the valve to PV).
     pub process: &'a Fit,
+    /// The identified PI.
     pub pi: &'a PiFit,
 }
 

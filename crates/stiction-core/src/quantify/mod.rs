@@ -1,7 +1,9 @@
 //! Quantifying stiction from OP and PV alone: closed-loop Hammerstein identification.
 //!
-//!   mv = stiction_θ(op)                         (the valve position is not measured)
-//!   A(q) y[t] = B(q) mv[t - nk] + c             (y = pv, or its change for integrating processes)
+//! ```text
+//! mv = stiction_θ(op)                         (the valve position is not measured)
+//! A(q) y[t] = B(q) mv[t - nk] + c             (y = pv, or its change for integrating processes)
+//! ```
 //!
 //! Separable: for fixed stiction parameters θ the valve position is simulated from OP and the
 //! linear part fitted by least squares; the outer search over θ ranks candidates by how well the
@@ -12,9 +14,9 @@
 //! The answer is an *apparent* stiction: inferred without the valve position, from data that an
 //! oscillating loop may not make fully identifiable.
 //!
-//! The stages, one file each: [`search`] runs them for one record (gates, pilot structures, the
-//! search per structure, the result); [`exact`] is the exact Stenman partition, [`heuristic`] the
-//! grid, ACO and polishing for the other models; [`start`] estimates where the valve stood at the
+//! The stages, one file each: `search` runs them for one record (gates, pilot structures, the
+//! search per structure, the result); `exact` is the exact Stenman partition, `heuristic` the
+//! grid, ACO and polishing for the other models; `start` estimates where the valve stood at the
 //! first sample; this file stages long records (first samples, then the whole record).
 
 mod compare;

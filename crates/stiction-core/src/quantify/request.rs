@@ -8,15 +8,21 @@ use serde::{Deserialize, Serialize};
 /// settings, and the linear model search.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct QuantifyRequest {
+    /// The stiction model to fit.
     pub model: ModelKind,
+    /// The search method for its parameters.
     pub method: Method,
     /// Sampling time in seconds (for the time constant and dead time).
     pub ts: f64,
     /// Search range per stiction parameter; `None`: 0 up to the OP's peak-to-peak range.
     pub bounds: Option<Vec<(f64, f64)>>,
+    /// Seed of the random searches (aco, aco-r).
     pub seed: u64,
+    /// Settings of the paper's ACO.
     pub aco: AcoSettings,
+    /// Settings of ACO_R.
     pub acor: AcorSettings,
+    /// Settings of the grid search (points per parameter).
     pub grid: GridSettings,
     /// Largest delay tried, in samples.
     pub max_delay: usize,
@@ -41,6 +47,9 @@ pub struct QuantifyRequest {
 }
 
 impl QuantifyRequest {
+    /// A request for `model` by `method` with the defaults: ts 1 s, seed 1, a 40-point grid, 60
+    /// ACO_R iterations, delays up to 30 samples, both process families, the full partition
+    /// staged on long records, the valve starting where OP does.
     pub fn new(model: ModelKind, method: Method) -> Self {
         let grid = GridSettings { points: 40 };
         Self {

@@ -62,14 +62,21 @@ pub enum ValveStartKind {
 pub struct LinearModel {
     /// Self-regulating (output pv) or integrating (output: the change of pv per sample).
     pub family: LinearFamily,
+    /// Output lags na.
     pub na: usize,
+    /// Input terms nb.
     pub nb: usize,
     /// Delay in samples from valve position to output (1 = the next sample).
     pub nk: usize,
-    /// y[t] = sum a_i y[t-i] + sum b_j mv[t-nk-j] + c, y and mv centred.
+    /// Output coefficients a_i of `y[t] = sum a_i y[t-i] + sum b_j mv[t-nk-j] + c`, y and mv
+    /// centred.
     pub a: Vec<f64>,
+    /// Input coefficients b_j.
     pub b: Vec<f64>,
+    /// Constant c, in the units of the centred output.
     pub c: f64,
+    /// Gain (PV units per OP unit; per second for an integrating process), when the coefficients
+    /// give one.
     pub gain: Option<f64>,
     /// Seconds.
     pub time_constant: Option<f64>,
@@ -79,12 +86,16 @@ pub struct LinearModel {
     pub criterion: String,
 }
 
+/// How well the fitted loop (stiction model and linear part) reproduces the output.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitQuality {
     /// The output the R² refer to: pv or its change per sample.
     pub output: FitOutput,
+    /// R² of the simulated output.
     pub r2_simulation: f64,
+    /// R² of the one-step prediction.
     pub r2_one_step: f64,
+    /// Sum of squares of the simulation error.
     pub sse_simulation: f64,
     /// R² in simulation of the best linear model of the same family with a valve that follows
     /// OP exactly (no stiction): how much of the fit the stiction model itself earns. `None` when
@@ -92,22 +103,31 @@ pub struct FitQuality {
     pub r2_simulation_without_stiction: Option<f64>,
 }
 
+/// The result of a closed-loop quantification (`quantify`): the stiction model's parameters
+/// estimated from OP and PV, with the linear process fitted with them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Quantification {
     /// Whether parameters were estimated.
     pub status: QuantifyStatus,
+    /// Why no parameters were estimated (`insufficient_data` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+    /// The stiction model fitted.
     pub model: ModelKind,
+    /// The search method used.
     pub method: Method,
+    /// Point estimate per parameter, in op's units.
     pub params: BTreeMap<String, f64>,
     /// Per parameter, the values that fit equally well: exact for Stenman with `exact` (the cells of
     /// least simulation error); for other methods, along each axis with the others held at the
     /// estimate.
     pub interval: BTreeMap<String, [f64; 2]>,
+    /// How `interval` was obtained.
     pub interval_kind: IntervalKind,
+    /// The identified linear part (absent without an answer).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub linear_model: Option<LinearModel>,
+    /// How well the fit reproduces the output (absent without an answer).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fit: Option<FitQuality>,
     /// The stiction band in OP units (% of valve span when OP is in %): Stenman d; He fs + fd;
@@ -115,7 +135,9 @@ pub struct Quantification {
     pub apparent_stiction: Option<f64>,
     /// The same band as a percentage of the OP's peak-to-peak range in the data.
     pub apparent_stiction_pct_of_op_range: Option<f64>,
+    /// The OP's peak-to-peak range in the data, OP units.
     pub op_range: f64,
+    /// Candidates fitted.
     pub evaluations: u64,
     /// Stenman with `exact`: the number of distinct valve trajectories.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -125,14 +147,21 @@ pub struct Quantification {
     /// first samples; "given").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub valve_start: Option<f64>,
+    /// How `valve_start` was chosen.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub valve_start_kind: Option<ValveStartKind>,
+    /// Time the quantification took, seconds.
     pub seconds: f64,
+    /// Samples in the record.
     pub samples: usize,
+    /// Sampling time, seconds.
     pub ts: f64,
+    /// The seed used (random searches only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
+    /// Caveats: a poor fit, a parameter at the top of its search range, a valve that hardly moves.
     pub warnings: Vec<String>,
+    /// What closed-loop data can and cannot tell (the same for every result).
     pub caveat: String,
     /// The estimated valve position (not serialised: for plots).
     #[serde(skip)]

@@ -18,7 +18,9 @@ use serde::{Deserialize, Serialize};
 /// `h` the controller period), clamped to 0..100 % (which also stops integral wind-up).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Pi {
+    /// Controller gain Kc, % of OP per PV unit (negative for direct action).
     pub kc: f64,
+    /// Integral time Ti, seconds.
     pub ti: f64,
 }
 
@@ -35,7 +37,9 @@ impl Pi {
 /// in % as the inner loop's. It runs at the inner controller's period.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Cascade {
+    /// The outer process, driven by the inner loop's PV.
     pub process: Process,
+    /// The outer controller.
     pub pi: Pi,
     /// The outer setpoint over time.
     pub setpoint: Signal,
@@ -64,8 +68,11 @@ impl Cascade {
 /// The fields after `seed` are plant features, all off by default (serialised only when set).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ClosedLoop {
+    /// The valve's stiction model.
     pub model: Model,
+    /// The process from valve position to PV.
     pub process: Process,
+    /// The PI controller.
     pub pi: Pi,
     /// Recording interval, seconds (and the controller period unless `controller_period` is set).
     pub ts: f64,
@@ -80,6 +87,7 @@ pub struct ClosedLoop {
     pub noise: f64,
     /// Optional output disturbance added to the PV (e.g. an external oscillation).
     pub disturbance: Option<Signal>,
+    /// Seed of the PV measurement noise.
     pub seed: u64,
     /// The controller executes (and the plant is stepped) every this many seconds; the historian
     /// samples the latest values every `ts` (as a DCS historian reads the function block). `None`:
@@ -143,6 +151,9 @@ pub struct LoopRun {
 }
 
 impl ClosedLoop {
+    /// A loop with `model` as the valve and the literature setup of [`ClosedLoop`] (K = 3, tau =
+    /// 10 s, delay = 10 s, Kc = 0.2, Ti = 10 s, Ts = 1 s): 2000 samples, a setpoint step from 50 to
+    /// 51 at 10 s, OP starting at 50 %, no noise, seed 0, no plant features.
     pub fn new(model: Model) -> Self {
         Self {
             model,
@@ -175,6 +186,7 @@ impl ClosedLoop {
         }
     }
 
+    /// An error naming the first setting that is out of range.
     pub fn validate(&self) -> Result<(), SimError> {
         self.process.validate()?;
         self.setpoint.validate()?;
@@ -221,7 +233,7 @@ impl ClosedLoop {
 
     /// Run the loop. Each controller period: measure pv, compute the error, the PI move (clamped
     /// to 0..100), the valve position; the process sees the valve position `delay` later. The
-    /// process starts at steady state with pv = sp[0] and op = mv = op0.
+    /// process starts at steady state with `pv = sp[0]` and `op = mv = op0`.
     ///
     /// ```
     /// use stiction_core::models::{Kano, Model};

@@ -39,10 +39,12 @@ pub enum QuantiseAt {
 }
 
 impl Quantisation {
+    /// An error unless the step is positive.
     pub fn validate(&self) -> Result<(), SimError> {
         require(self.step > 0.0, "quantisation step", "> 0", self.step)
     }
 
+    /// `x` rounded to the nearest multiple of the step.
     #[inline]
     pub fn apply(&self, x: f64) -> f64 {
         (x / self.step).round() * self.step
@@ -53,7 +55,10 @@ impl Quantisation {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CompressionMethod {
+    /// Deadband (exception) storage: a point when the signal leaves the deviation around the last
+    /// stored one.
     Deadband,
+    /// Swinging door: the fewest points whose straight lines stay within the deviation.
     SwingingDoor,
 }
 
@@ -70,13 +75,16 @@ pub enum Reconstruction {
 /// Historian compression of one recorded signal.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Compression {
+    /// Which storage rule.
     pub method: CompressionMethod,
     /// The compression deviation, in the signal's units.
     pub deviation: f64,
+    /// How values between stored points are returned.
     pub reconstruction: Reconstruction,
 }
 
 impl Compression {
+    /// An error unless the deviation is >= 0.
     pub fn validate(&self) -> Result<(), SimError> {
         require(
             self.deviation >= 0.0,
@@ -104,17 +112,21 @@ impl Compression {
 /// Compression of the recorded PV and, optionally, OP (no compression by default).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Historian {
+    /// Compression of the recorded PV, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pv: Option<Compression>,
+    /// Compression of the recorded OP, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub op: Option<Compression>,
 }
 
 impl Historian {
+    /// Whether neither signal is compressed.
     pub fn is_none(&self) -> bool {
         self.pv.is_none() && self.op.is_none()
     }
 
+    /// An error unless every compression's deviation is >= 0.
     pub fn validate(&self) -> Result<(), SimError> {
         self.pv
             .iter()

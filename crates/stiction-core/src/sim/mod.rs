@@ -26,12 +26,17 @@ use crate::models::Model;
 use crate::rng::{gaussian, seeded};
 use serde::{Deserialize, Serialize};
 
+/// A simulation setting out of range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
+    /// A setting breaks its rule.
     #[error("{what} must be {rule}, got {value}")]
     Invalid {
+        /// The setting, in words.
         what: &'static str,
+        /// What it must be.
         rule: &'static str,
+        /// The value given.
         value: f64,
     },
 }
@@ -53,10 +58,15 @@ pub(crate) fn require(
 /// process variable. Open-loop runs have no setpoint and no process: `sp` and `pv` are empty.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct LoopData {
+    /// Time of each sample, seconds.
     pub t: Vec<f64>,
+    /// Setpoint (empty open loop).
     pub sp: Vec<f64>,
+    /// Controller output: the valve's command, % of valve span.
     pub op: Vec<f64>,
+    /// Valve position, % of valve span.
     pub mv: Vec<f64>,
+    /// Process variable (empty open loop).
     pub pv: Vec<f64>,
 }
 

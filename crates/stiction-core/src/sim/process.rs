@@ -9,20 +9,38 @@ use serde::{Deserialize, Serialize};
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Process {
     /// `K e^{-delay s} / (tau s + 1)`, discretised exactly with a zero-order hold.
-    Foptd { k: f64, tau: f64, delay: f64 },
+    Foptd {
+        /// Gain K, PV units per % of flow.
+        k: f64,
+        /// Time constant, seconds.
+        tau: f64,
+        /// Dead time, seconds.
+        delay: f64,
+    },
     /// `K e^{-delay s} / s` (a level loop), discretised with a zero-order hold.
-    Integrating { k: f64, delay: f64 },
+    Integrating {
+        /// Rate K, PV units per second per % of flow.
+        k: f64,
+        /// Dead time, seconds.
+        delay: f64,
+    },
     /// `K e^{-delay s} / ((tau1 s + 1)(tau2 s + 1))`, two lags in series (slow temperature and
     /// analyser loops), discretised exactly with a zero-order hold; `tau1 = tau2` is allowed.
     Soptd {
+        /// Gain K, PV units per % of flow.
         k: f64,
+        /// First time constant, seconds.
         tau1: f64,
+        /// Second time constant, seconds.
         tau2: f64,
+        /// Dead time, seconds.
         delay: f64,
     },
 }
 
 impl Process {
+    /// An error naming the first parameter out of range (K zero, a time constant not positive,
+    /// a negative dead time).
     pub fn validate(&self) -> Result<(), SimError> {
         match *self {
             Process::Foptd { k, tau, delay } => {
@@ -66,6 +84,7 @@ impl Process {
         }
     }
 
+    /// Whether this is an integrating process.
     pub fn is_integrating(&self) -> bool {
         matches!(self, Process::Integrating { .. })
     }
@@ -104,27 +123,43 @@ impl Process {
 /// input held over the next step.
 #[derive(Debug, Clone, Copy)]
 pub enum ProcessState {
+    /// A first-order lag.
     Lag {
+        /// Gain K.
         k: f64,
+        /// Pole `exp(-h / tau)`.
         a: f64,
+        /// Output, in deviation from the operating point.
         y: f64,
     },
+    /// An integrator.
     Integrator {
+        /// Rate K per second.
         k: f64,
+        /// Step, seconds.
         h: f64,
+        /// Output, in deviation from the operating point.
         y: f64,
     },
+    /// Two first-order lags in series.
     TwoLags {
+        /// Gain K.
         k: f64,
+        /// Pole of the first lag, `exp(-h / tau1)`.
         a1: f64,
+        /// Pole of the second lag, `exp(-h / tau2)`.
         a2: f64,
+        /// The first lag's effect on the second over one step.
         phi: f64,
+        /// State of the first lag.
         x1: f64,
+        /// State of the second lag (the output is `k x2`).
         x2: f64,
     },
 }
 
 impl ProcessState {
+    /// The output now, in deviation from the operating point.
     pub fn output(&self) -> f64 {
         match *self {
             ProcessState::Lag { y, .. } | ProcessState::Integrator { y, .. } => y,

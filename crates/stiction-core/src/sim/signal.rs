@@ -16,53 +16,91 @@ use serde::{Deserialize, Serialize};
 pub enum Signal {
     /// `offset + amplitude * sin(2 pi t / period)`.
     Sine {
+        /// Amplitude, in the signal's units.
         amplitude: f64,
+        /// Period, seconds.
         period: f64,
+        /// Mean level.
         offset: f64,
     },
     /// A symmetric triangle wave between `offset - amplitude` and `offset + amplitude`, starting at
     /// `offset` and rising.
     Triangle {
+        /// Amplitude, in the signal's units.
         amplitude: f64,
+        /// Period, seconds.
         period: f64,
+        /// Mean level.
         offset: f64,
     },
     /// `offset` plus a Gaussian random walk with step standard deviation `step_std` (one step per
     /// sample).
     RandomWalk {
+        /// Standard deviation of each step.
         step_std: f64,
+        /// The level at the first sample.
         offset: f64,
+        /// Seed of the steps.
         seed: u64,
     },
     /// Random levels, uniform in `offset ± amplitude`, each held for `hold` seconds.
     Steps {
+        /// Largest distance of a level from `offset`.
         amplitude: f64,
+        /// Time each level is held, seconds.
         hold: f64,
+        /// Middle of the levels.
         offset: f64,
+        /// Seed of the levels.
         seed: u64,
     },
     /// `from` until time `at`, then `to`.
-    Step { from: f64, to: f64, at: f64 },
+    Step {
+        /// Level before the step.
+        from: f64,
+        /// Level after the step.
+        to: f64,
+        /// Time of the step, seconds.
+        at: f64,
+    },
     /// A constant.
-    Constant { value: f64 },
+    Constant {
+        /// The level.
+        value: f64,
+    },
     /// `offset` until time `start`, then rising (or falling) by `slope` per second.
-    Ramp { slope: f64, start: f64, offset: f64 },
+    Ramp {
+        /// Rate, units per second.
+        slope: f64,
+        /// Time the ramp starts, seconds.
+        start: f64,
+        /// Level before the ramp.
+        offset: f64,
+    },
     /// A setpoint step sequence as operators make it: random levels, uniform in
     /// `offset ± amplitude`, each held for a random time uniform in `min_hold..=max_hold` seconds.
     /// The first level is `offset` itself (the loop starts at its operating point).
     RandomSteps {
+        /// Largest distance of a level from `offset`.
         amplitude: f64,
+        /// Shortest hold, seconds.
         min_hold: f64,
+        /// Longest hold, seconds.
         max_hold: f64,
+        /// The first level and the middle of the others.
         offset: f64,
+        /// Seed of the levels and holds.
         seed: u64,
     },
     /// A slow load drift: `offset` plus an integrated random walk. The slope (units per second)
     /// starts at 0 and is itself a random walk whose increments over one second have standard
     /// deviation `slope_std`; the level integrates the slope.
     IntegratedRandomWalk {
+        /// Standard deviation of the slope's increments over one second.
         slope_std: f64,
+        /// The level at the first sample.
         offset: f64,
+        /// Seed of the increments.
         seed: u64,
     },
     /// Random narrow-band noise around `period`: white noise through a second-order resonator
@@ -71,16 +109,25 @@ pub enum Signal {
     /// `amplitude` (amplitude / √2); small `damping` (0.02..0.2) gives a waxing and waning
     /// oscillation that is not a pure sinusoid.
     NarrowBand {
+        /// Amplitude of the sine of equal standard deviation.
         amplitude: f64,
+        /// Centre period, seconds.
         period: f64,
+        /// The resonator's damping ratio.
         damping: f64,
+        /// Seed of the white noise.
         seed: u64,
     },
     /// The sum of several signals.
-    Sum { parts: Vec<Signal> },
+    Sum {
+        /// The signals added.
+        parts: Vec<Signal>,
+    },
 }
 
 impl Signal {
+    /// An error naming the first setting out of range (a negative amplitude, a period or hold
+    /// that is not positive, a value that is not finite).
     pub fn validate(&self) -> Result<(), SimError> {
         match self {
             Signal::Sine {

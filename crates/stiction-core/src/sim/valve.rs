@@ -20,10 +20,14 @@ pub enum Characteristic {
     /// `flow = 100 (R^{x/100} - 1) / (R - 1)`. The local gain grows by the factor `R` (the
     /// rangeability, typically 20..50) from closed to open, so the loop gain depends on where the
     /// valve works (ISA-75.11; Emerson, *Control Valve Handbook*, ch. 2).
-    EqualPercentage { rangeability: f64 },
+    EqualPercentage {
+        /// The rangeability R (> 1).
+        rangeability: f64,
+    },
 }
 
 impl Characteristic {
+    /// An error unless an equal-percentage rangeability exceeds 1.
     pub fn validate(&self) -> Result<(), SimError> {
         match *self {
             Characteristic::Linear => Ok(()),
@@ -66,11 +70,13 @@ pub struct ValveLag {
 }
 
 impl ValveLag {
+    /// A lag of time constant `tau` seconds stepped every `h` seconds, starting at position `x0`.
     pub fn new(tau: f64, h: f64, x0: f64) -> Self {
         let a = if tau > 0.0 { (-h / tau).exp() } else { 0.0 };
         Self { a, x: x0 }
     }
 
+    /// One step toward `target` (the stiction model's output); returns the position.
     #[inline]
     pub fn step(&mut self, target: f64) -> f64 {
         self.x = if self.a == 0.0 {

@@ -42,7 +42,9 @@ pub struct Bicoherence {
     pub nli: f64,
     /// Total non-linearity index: the sum of the significant squared bicoherence.
     pub tnli: f64,
+    /// The NGI threshold used: non-Gaussian above it.
     pub ngi_threshold: f64,
+    /// The NLI threshold used: a non-Gaussian signal is non-linear above it.
     pub nli_threshold: f64,
     /// Number of segments K averaged.
     pub segments: usize,
@@ -52,7 +54,9 @@ pub struct Bicoherence {
     pub peak: [f64; 2],
     /// The largest squared bicoherence.
     pub peak_value: f64,
+    /// Whether NGI exceeds its threshold.
     pub non_gaussian: bool,
+    /// Whether the signal is non-Gaussian and NLI exceeds its threshold.
     pub non_linear: bool,
 }
 

@@ -8,8 +8,11 @@ use super::*;
 /// An ellipse fitted to a PV-OP plot (x = OP, y = PV), in the data's units.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Ellipse {
+    /// Centre (OP, PV).
     pub centre: [f64; 2],
+    /// Semi-major axis a, data units.
     pub semi_major: f64,
+    /// Semi-minor axis b, data units.
     pub semi_minor: f64,
     /// Angle of the major axis from the x (OP) axis, radians, in (−π/2, π/2].
     pub angle: f64,

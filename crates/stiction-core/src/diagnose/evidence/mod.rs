@@ -29,9 +29,13 @@ pub use valve::ValveEvidence;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Family {
+    /// The shape of the oscillation: the literature's indices on oscillating stretches.
     Shape,
+    /// The closed-loop Hammerstein fits with and without stiction.
     Model,
+    /// Episodes of OP travelling while PV stays put, ended by a PV jump.
     StickSlip,
+    /// The recorded valve position (mv) against OP.
     Valve,
     /// The identified loop and its limit cycle.
     Loop,
@@ -64,7 +68,9 @@ impl Family {
 /// What one family found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FamilyEvidence {
+    /// Which family.
     pub family: Family,
+    /// Its vote.
     pub vote: Vote,
     /// 0..1: how strongly the evidence holds the vote (1: decisive; for `undetermined`, 0).
     pub strength: f64,
@@ -76,12 +82,16 @@ pub struct FamilyEvidence {
     pub threshold: String,
     /// Why it voted as it did, or why it could not vote.
     pub note: String,
+    /// The model family's details (on its evidence only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model: Option<ModelEvidence>,
+    /// The stick-slip family's details (on its evidence only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stick_slip: Option<StickSlipEvidence>,
+    /// The valve family's details (on its evidence only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub valve: Option<ValveEvidence>,
+    /// The loop family's details (on its evidence only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limit_cycle: Option<LoopEvidence>,
 }
@@ -107,10 +117,15 @@ impl FamilyEvidence {
 
 /// Everything the families read: the analysed stretch and what is computed once for all.
 pub struct Context<'a> {
+    /// The request's settings and limits.
     pub req: &'a DiagnoseRequest,
+    /// OP over the analysed stretch, OP units.
     pub op: &'a [f64],
+    /// PV over the analysed stretch.
     pub pv: &'a [f64],
+    /// SP over the analysed stretch, when recorded.
     pub sp: Option<&'a [f64]>,
+    /// The recorded valve position (mv) over the analysed stretch, OP units, when recorded.
     pub mv: Option<&'a [f64]>,
     /// The control error (SP - PV, or the PV's deviation from its mean without SP).
     pub error: Vec<f64>,
@@ -118,6 +133,7 @@ pub struct Context<'a> {
     pub oscillation: Oscillation,
     /// Robust noise standard deviations of PV and OP (from first differences).
     pub pv_noise: f64,
+    /// The same for OP.
     pub op_noise: f64,
     /// The PV's resolution when it is quantised.
     pub pv_quantum: Option<f64>,
@@ -132,7 +148,9 @@ pub struct Context<'a> {
 
 /// One family of evidence.
 pub trait EvidenceFamily {
+    /// Which family this is.
     fn family(&self) -> Family;
+    /// The family's evidence on the analysed stretch.
     fn evaluate(&self, ctx: &Context) -> FamilyEvidence;
 }
 

@@ -66,13 +66,17 @@ pub struct ModelEvidence {
     pub structure: Structure,
     /// R² in simulation of the output (PV, or its change for an integrating structure).
     pub r2_without_stiction: f64,
+    /// R² in simulation of the output with Stenman's valve.
     pub r2_stenman: f64,
+    /// R² in simulation of the output with Kano's valve (a band S and a slip jump J of its own).
     pub r2_slip_jump: f64,
     /// Stenman's band, OP units and % of span.
     pub stenman_d: f64,
+    /// Stenman's band, % of valve span.
     pub stenman_d_percent_of_span: f64,
     /// Kano's band S and slip jump J, OP units.
     pub kano_s: f64,
+    /// Kano's slip jump J, OP units.
     pub kano_j: f64,
     /// The improvement of the better stiction fit over the linear loop, share of the output's
     /// variance above its noise.
@@ -84,20 +88,30 @@ pub struct ModelEvidence {
     pub explained: f64,
     /// Share of the output's variance that is noise.
     pub noise_share: f64,
+    /// Gain of the linear part fitted with the best stiction model (PV units per OP unit; per
+    /// second for an integrating process).
     pub gain: Option<f64>,
+    /// Its time constant, seconds.
     pub time_constant: Option<f64>,
+    /// Its dead time, seconds.
     pub dead_time: f64,
     /// The comparison behind the shares: samples compared, the lag of the changes compared
     /// (samples), their sum of squares, the linear loop's and the best stiction model's simulation
     /// error, and the measurement noise's expected share of them.
     pub samples: usize,
+    /// The lag of the changes compared, samples.
     pub lag: usize,
     /// Where the fitted valve stood at the first sample (OP units).
     pub valve_start: f64,
+    /// Sum of squares of the centred compared output.
     pub sst: f64,
+    /// Simulation error (sum of squares) of the linear loop (a valve that follows OP).
     pub sse_linear: f64,
+    /// Simulation error (sum of squares) of the better stiction model.
     pub sse_stiction: f64,
+    /// The measurement noise's expected sum of squares over the samples compared.
     pub sse_noise: f64,
+    /// How the test ratio was calibrated ([`CALIBRATION`]).
     pub calibration: String,
 }
 

@@ -50,16 +50,21 @@ pub struct StickSlipEvidence {
     pub stuck_share: f64,
     /// Median OP travel per episode: a model-free band estimate, OP units and % of span.
     pub median_travel: Option<f64>,
+    /// The same, % of valve span.
     pub median_travel_percent_of_span: Option<f64>,
     /// The PV band's half-width (PV units) and the OP noise (OP units) the episodes are held to.
     pub pv_band: f64,
+    /// The OP noise standard deviation, OP units.
     pub op_noise: f64,
     /// Quiet stretches of PV the record was cut into.
     pub quiet_stretches: usize,
     /// Look-alikes left out: PV not recorded; a healthy valve would not have moved PV yet; PV
     /// moved against OP's push.
     pub skipped_unrecorded: usize,
+    /// Episodes left out because a healthy valve would not have moved PV yet (a slow process or a
+    /// long delay).
     pub skipped_slow: usize,
+    /// Episodes left out because PV moved against OP's push.
     pub skipped_direction: usize,
     /// The episodes, as sample ranges `[start, end)` of the analysed stretch.
     pub ranges: Vec<[usize; 2]>,
@@ -67,8 +72,12 @@ pub struct StickSlipEvidence {
 
 /// What the episode search needs besides OP and PV.
 pub struct Settings<'a> {
+    /// Noise standard deviation of the judged signal (PV, or an integrating PV's change per
+    /// sample).
     pub pv_noise: f64,
+    /// Noise standard deviation of OP, OP units.
     pub op_noise: f64,
+    /// The judged signal's resolution when it is quantised (the PV band is at least this).
     pub pv_quantum: Option<f64>,
     /// PV samples that look not recorded.
     pub unrecorded: &'a [bool],

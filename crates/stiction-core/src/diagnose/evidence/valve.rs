@@ -17,6 +17,7 @@ pub const BAND_NOISE_SIGMAS: f64 = 4.0;
 /// ... and at least this share of the valve span (%) votes stiction, when the band removes at
 /// least `MIN_IMPROVEMENT` of the misfit of a valve that follows OP.
 pub const MIN_BAND_PERCENT: f64 = 0.2;
+/// The share of the misfit of a valve that follows OP that the band must remove to vote stiction.
 pub const MIN_IMPROVEMENT: f64 = 0.3;
 
 /// The valve position against OP.
@@ -24,10 +25,13 @@ pub const MIN_IMPROVEMENT: f64 = 0.3;
 pub struct ValveEvidence {
     /// Stenman's band, OP units and % of span, with its proven optimal set.
     pub d: f64,
+    /// Stenman's band, % of valve span.
     pub d_percent_of_span: f64,
+    /// The exact solver's proven interval of equally good bands, % of valve span.
     pub interval: Option<[f64; 2]>,
     /// R² of MV with the band and with a valve that follows OP.
     pub r2: f64,
+    /// R² of MV with a valve that follows OP.
     pub r2_without_stiction: f64,
     /// The MV's noise standard deviation (robust, from first differences).
     pub mv_noise: f64,

@@ -77,13 +77,16 @@ pub struct FitComparison {
     pub valve_start: f64,
     /// The valve follows OP.
     pub linear: ModelFit,
+    /// Stenman's valve: one band d.
     pub stenman: ModelFit,
     /// Kano (S, J): a band and a slip jump of their own.
     pub slip_jump: ModelFit,
     /// Gain (PV units per OP unit; per second for an integrating process), time constant and
     /// dead time (seconds) of the linear part fitted with the best stiction model.
     pub gain: Option<f64>,
+    /// Time constant of the linear part, seconds (`None` without a real pole between 0 and 1).
     pub time_constant: Option<f64>,
+    /// Dead time of the linear part, seconds.
     pub dead_time: f64,
     /// Candidates fitted.
     pub evaluations: u64,
@@ -102,6 +105,7 @@ pub struct FitComparison {
     /// the PV's.
     #[serde(skip)]
     pub linear_model: Option<Fit>,
+    /// The best stiction model's linear part, as `linear_model`.
     #[serde(skip)]
     pub stiction_model: Option<Fit>,
     /// The mean OP subtracted from the valve position before fitting levels.

@@ -41,6 +41,7 @@ pub enum LoopClass {
 }
 
 impl LoopClass {
+    /// Every class, in catalogue order.
     pub const ALL: [LoopClass; 14] = [
         Self::StenmanValve,
         Self::KanoValve,
@@ -58,6 +59,7 @@ impl LoopClass {
         Self::CascadeInner,
     ];
 
+    /// The truth a verdict on this class is judged against.
     pub fn truth(self) -> Truth {
         match self {
             Self::StenmanValve | Self::KanoValve | Self::HeValve => Truth::Sticky,
@@ -113,13 +115,16 @@ impl std::str::FromStr for LoopClass {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Truth {
+    /// A sticky valve: the verdict should be `stiction`.
     Sticky,
+    /// No sticky valve: a `stiction` verdict is a false alarm.
     NotSticky,
     /// A dead band without slip jump: neither goal applies.
     BacklashOnly,
 }
 
 impl Truth {
+    /// The name used in tables (as serialised).
     pub fn name(self) -> &'static str {
         match self {
             Self::Sticky => "sticky",
@@ -133,16 +138,22 @@ impl Truth {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LoopKind {
+    /// A flow loop.
     Flow,
+    /// A pressure loop.
     Pressure,
     /// A level (integrating process).
     Level,
+    /// A temperature loop.
     Temperature,
+    /// An analyser loop.
     Analyser,
+    /// A cooling-water loop.
     CoolingWater,
 }
 
 impl LoopKind {
+    /// The name used in tables (as serialised).
     pub fn name(self) -> &'static str {
         match self {
             Self::Flow => "flow",
@@ -168,8 +179,10 @@ pub enum NoiseLevel {
 }
 
 impl NoiseLevel {
+    /// Every level, low to high.
     pub const ALL: [NoiseLevel; 3] = [Self::Low, Self::Medium, Self::High];
 
+    /// The PV noise's standard deviation, % of span.
     pub fn std(self) -> f64 {
         match self {
             Self::Low => 0.03,
@@ -200,9 +213,19 @@ pub enum Excitation {
 #[serde(tag = "rule", rename_all = "snake_case")]
 pub enum Tuning {
     /// SIMC (Skogestad 2003) for closed-loop time constant `lambda` seconds.
-    Simc { lambda: f64 },
+    Simc {
+        /// The closed-loop time constant, seconds.
+        lambda: f64,
+    },
     /// `Kc = fraction * Ku` at the chosen integral time; `ku`, `pu` of the linear loop.
-    Ultimate { fraction: f64, ku: f64, pu: f64 },
+    Ultimate {
+        /// Kc over the ultimate gain.
+        fraction: f64,
+        /// The ultimate gain: the Kc at which the linear loop reaches its stability limit.
+        ku: f64,
+        /// The ultimate period: the period it then oscillates with, seconds.
+        pu: f64,
+    },
 }
 
 /// One benchmark loop: what it is, how it was made, and its record.
@@ -210,17 +233,25 @@ pub enum Tuning {
 pub struct BenchmarkLoop {
     /// `routine-b-0042` (suite, b = benchmark or c = calibration, index), or `issue14`.
     pub id: String,
+    /// Which suite the loop belongs to.
     pub suite: Suite,
+    /// Benchmark or calibration seeds.
     pub set: Set,
+    /// What is wrong (or not) with the loop.
     pub class: LoopClass,
+    /// The truth its verdict is judged against.
     pub truth: Truth,
+    /// The plant loop it stands for.
     pub kind: LoopKind,
     /// The parameters in words.
     pub description: String,
     /// The process is integrating (for `diagnose`'s `integrating`).
     pub integrating: bool,
+    /// The PV's measurement noise.
     pub noise_level: NoiseLevel,
+    /// What keeps the loop moving.
     pub excitation: Excitation,
+    /// How the controller was tuned.
     pub tuning: Tuning,
     /// Everything the simulation used: valve model and parameters (% of span), process, PI,
     /// noise, signals, plant features. `setup.run()` gives `data` again.

@@ -48,7 +48,9 @@ pub const MAX_ATTEMPTS: u64 = 12;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Suite {
+    /// Routine historian windows (issue 10).
     Routine,
+    /// Fast limit-cycling loops (issue 14).
     Fast,
 }
 
@@ -56,7 +58,9 @@ pub enum Suite {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Set {
+    /// The seeds the benchmark reports.
     Benchmark,
+    /// Other seeds, for setting thresholds.
     Calibration,
 }
 

@@ -14,7 +14,9 @@ use std::f64::consts::PI;
 /// the local gain of the valve's characteristic.
 #[derive(Debug, Clone, Copy)]
 pub struct LinearLoop {
+    /// The process.
     pub process: Process,
+    /// First-order actuator lag, seconds.
     pub valve_lag: f64,
     /// Controller period, seconds.
     pub h: f64,

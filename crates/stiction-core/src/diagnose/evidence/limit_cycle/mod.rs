@@ -48,8 +48,13 @@ pub const MAX_CONTROLLER_RESIDUAL: f64 = 0.3;
 /// function of a valve lags by at most 90 degrees), full strength at `FULL_LAG`; below
 /// `LINEAR_LAG` the linear loop sustains the cycle by itself.
 pub const MIN_LAG: f64 = 25.0;
+/// The largest valve lag that counts as stiction, degrees (a valve's describing function lags by at
+/// most 90).
 pub const MAX_LAG: f64 = 90.0;
+/// The valve lag at which the stiction vote reaches full strength, degrees.
 pub const FULL_LAG: f64 = 50.0;
+/// Below this valve lag, degrees (and within `LINEAR_GAIN` of a gain of 1), the linear loop
+/// sustains the cycle by itself.
 pub const LINEAR_LAG: f64 = 10.0;
 /// ... and within this of a gain of 1.
 pub const LINEAR_GAIN: f64 = 0.15;
@@ -67,6 +72,8 @@ pub const LIMIT_CYCLES: f64 = 0.25;
 /// cycle (standard deviation of its logarithm), is reported as a linear loop's (not a vote: on
 /// plant data stick-slip cycles wander too).
 pub const UNSTEADY_CHANGE: f64 = 0.5;
+/// The scatter of the cycle amplitudes (standard deviation of their logarithm) at which the
+/// amplitude is reported as unsteady.
 pub const UNSTEADY_SCATTER: f64 = 0.25;
 /// A predicted period within this factor of the observed one matches it.
 pub const PERIOD_MATCH: f64 = 1.25;
@@ -97,9 +104,11 @@ pub enum ProcessSource {
 pub struct DescribingBand {
     /// The valve: Stenman's band, or Kano's S with slip ratio J / S.
     pub model: ModelKind,
+    /// Kano's slip ratio J / S (1 for Stenman).
     pub slip_ratio: f64,
     /// The band (Stenman's d, Kano's S), OP units and % of span.
     pub band: f64,
+    /// The band, % of valve span.
     pub band_percent_of_span: f64,
     /// The OP amplitude over the band.
     pub amplitude_over_band: f64,
@@ -119,13 +128,16 @@ pub struct LoopEvidence {
     pub controller: PiFit,
     /// Whether a setpoint was recorded (without it the error is the PV's deviation from its mean).
     pub setpoint_recorded: bool,
+    /// Which fit the process model comes from.
     pub process: ProcessSource,
     /// The identified linear loop's margins.
     pub margins: Margins,
     /// The observed cycle: mean period (s), mean amplitudes of the fundamental of OP and PV per
     /// cycle.
     pub period: f64,
+    /// Mean amplitude of OP's fundamental per cycle, OP units.
     pub op_amplitude: f64,
+    /// Mean amplitude of PV's fundamental per cycle, PV units.
     pub pv_amplitude: f64,
     /// Harmonic distortion of the cycle (the larger of OP's and PV's; harmonics 2 to 5 over the
     /// fundamental's power).
@@ -147,6 +159,7 @@ pub struct LoopEvidence {
     /// (degrees). A linear loop at its stability limit needs nothing (gain 1, lag 0); a sticky
     /// valve gives a lag.
     pub needed_gain: f64,
+    /// The needed describing function's phase lag, degrees.
     pub needed_lag_degrees: f64,
     /// The valve and band that give it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -154,6 +167,7 @@ pub struct LoopEvidence {
     /// Caveats (a missing setpoint, a cascade).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub caveat: Option<String>,
+    /// How the thresholds were set ([`CALIBRATION`]).
     pub calibration: String,
 }
 
