@@ -444,6 +444,23 @@ fn bad_bounds_and_names() {
         &["tau", "> 0"],
     );
     fails(&["reproduce", "everything"], &["everything", "paper"]);
+    // a method's settings: the core names the setting, the message the flag that sets it
+    fails(
+        &["estimate", &f, "--method", "aco", "--ants", "0"],
+        &["--ants must be at least 1, got 0"],
+    );
+    fails(
+        &["estimate", &f, "--method", "aco", "--rho", "1"],
+        &["--rho must be between 0 and 1, exclusive, got 1"],
+    );
+    fails(
+        &["estimate", &f, "--method", "aco-r", "--locality", "0"],
+        &["--locality must be a finite number > 0, got 0"],
+    );
+    fails(
+        &["estimate", &f, "--method", "grid", "--points", "1"],
+        &["--points must be at least 2, got 1"],
+    );
 }
 
 // ----------------------------------------------------------------------------- quantify

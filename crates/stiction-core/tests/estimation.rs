@@ -175,6 +175,15 @@ fn bad_requests_are_refused() {
         .unwrap_err()
         .to_string()
         .contains("sample 7"));
+    // a method's setting is named as in its settings, with the value: no front end's flag
+    let mut req = Request::new(ModelKind::Stenman, Method::Aco);
+    req.aco.ants = 0;
+    let e = estimate(&op, &mv, &req).unwrap_err().to_string();
+    assert_eq!(e, "aco ants must be at least 1, got 0");
+    let mut req = Request::new(ModelKind::Kano, Method::AcoR);
+    req.acor.q = 0.0;
+    let e = estimate(&op, &mv, &req).unwrap_err().to_string();
+    assert_eq!(e, "aco-r q must be a finite number > 0, got 0");
 }
 
 #[test]

@@ -103,7 +103,20 @@ pub enum EstimateError {
         /// What is wrong with it.
         why: &'static str,
     },
-    /// A method's settings out of range.
+    /// A method's setting out of range, named as in the method's settings (`ants`, `rho`, ...).
+    #[error("{method} {name} must be {rule}, got {value}")]
+    Setting {
+        /// The method whose setting it is.
+        method: Method,
+        /// The setting's name, that of its field in the method's settings.
+        name: &'static str,
+        /// What it must be.
+        rule: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// Settings that do not fit the model (bounds for another number of parameters) or the data
+    /// (a sampling time that is not positive).
     #[error("{0}")]
     Settings(String),
     /// Data that cannot be estimated from (lengths, non-finite values, too few samples, a constant
@@ -174,40 +187,68 @@ impl Request {
         Ok(bounds)
     }
 
-    fn check_settings(&self) -> Result<(), EstimateError> {
-        let bad = |m: &str| Err(EstimateError::Settings(m.to_string()));
-        match self.method {
+    /// Check the chosen method's settings (the first one out of range is the error) and that the
+    /// exact method is asked for Stenman only. [`estimate`] checks them too; a front end may check
+    /// them before it reads any data.
+    pub fn check_settings(&self) -> Result<(), EstimateError> {
+        let method = self.method;
+        let check = |ok: bool, name: &'static str, rule: &'static str, value: f64| {
+            if ok {
+                Ok(())
+            } else {
+                Err(EstimateError::Setting {
+                    method,
+                    name,
+                    rule,
+                    value,
+                })
+            }
+        };
+        const AT_LEAST_1: &str = "at least 1";
+        const POSITIVE: &str = "a finite number > 0";
+        match method {
             Method::Aco => {
                 let s = &self.aco;
-                if s.ants == 0 || s.iterations == 0 {
-                    return bad("--ants and --iterations must be at least 1");
-                }
-                if !(positive(s.rho) && s.rho < 1.0) {
-                    return bad("--rho (evaporation) must be between 0 and 1, exclusive");
-                }
-                if !positive(s.q) || !(s.elitist == 0.0 || positive(s.elitist)) {
-                    return bad("--q must be > 0 and --elitist >= 0");
-                }
-                if !positive(s.resolution) {
-                    return bad("--resolution must be > 0");
-                }
-                if !positive(s.tau0) || !positive(s.epsilon) {
-                    return bad("--tau0 and --epsilon must be > 0");
-                }
+                check(s.ants >= 1, "ants", AT_LEAST_1, s.ants as f64)?;
+                check(
+                    s.iterations >= 1,
+                    "iterations",
+                    AT_LEAST_1,
+                    s.iterations as f64,
+                )?;
+                check(
+                    positive(s.rho) && s.rho < 1.0,
+                    "rho",
+                    "between 0 and 1, exclusive",
+                    s.rho,
+                )?;
+                check(positive(s.q), "q", POSITIVE, s.q)?;
+                check(
+                    s.elitist == 0.0 || positive(s.elitist),
+                    "elitist",
+                    "a finite number >= 0",
+                    s.elitist,
+                )?;
+                check(positive(s.resolution), "resolution", POSITIVE, s.resolution)?;
+                check(positive(s.tau0), "tau0", POSITIVE, s.tau0)?;
+                check(positive(s.epsilon), "epsilon", POSITIVE, s.epsilon)?;
             }
             Method::AcoR => {
                 let s = &self.acor;
-                if s.ants == 0 || s.iterations == 0 || s.archive < 2 {
-                    return bad("--ants and --iterations must be at least 1, --archive at least 2");
-                }
-                if !positive(s.q) || !positive(s.xi) {
-                    return bad("--q and --xi must be > 0");
-                }
+                check(s.ants >= 1, "ants", AT_LEAST_1, s.ants as f64)?;
+                check(
+                    s.iterations >= 1,
+                    "iterations",
+                    AT_LEAST_1,
+                    s.iterations as f64,
+                )?;
+                check(s.archive >= 2, "archive", "at least 2", s.archive as f64)?;
+                check(positive(s.q), "q", POSITIVE, s.q)?;
+                check(positive(s.xi), "xi", POSITIVE, s.xi)?;
             }
             Method::Grid => {
-                if self.grid.points < 2 {
-                    return bad("--points must be at least 2");
-                }
+                let points = self.grid.points;
+                check(points >= 2, "points", "at least 2", points as f64)?;
             }
             Method::Exact => {
                 if self.model != ModelKind::Stenman {
