@@ -338,7 +338,7 @@ pub fn vanished(loops_dir: &Path, ids: &Ids) -> Vec<Row> {
         let path = e.path();
         let Some(id) = path
             .extension()
-            .is_some_and(|x| x == "json")
+            .is_some_and(|x| x.eq_ignore_ascii_case("json"))
             .then(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()))
             .flatten()
         else {
