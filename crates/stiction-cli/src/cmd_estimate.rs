@@ -1,6 +1,6 @@
 use crate::loop_file::Reading;
 use crate::words::count;
-use crate::{cmd_simulate::write_atomic, data, spec};
+use crate::{atomic::write_atomic, data, spec};
 use anyhow::{bail, Result};
 use std::path::PathBuf;
 use stiction_core::estimate::{self, Estimate, EstimateError, IntervalKind, Method, Request};

@@ -1,5 +1,4 @@
-// `report` and `estimate` still name the helper by this path
-pub use crate::atomic::write_atomic;
+use crate::atomic::write_atomic;
 use crate::spec;
 use crate::words::count;
 use anyhow::{bail, Result};
