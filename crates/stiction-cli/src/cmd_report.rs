@@ -1,13 +1,15 @@
 //! `stiction report`: diagnose a loop and write one self-contained HTML page: inline SVG charts,
 //! inline CSS, no scripts, fonts, images or links outside the file, readable on a laptop, a phone
-//! and on paper. The page itself is [`crate::report`]'s.
+//! and on paper. The page itself is [`stiction_report`]'s
+//! (shared with the Python package's `stiction.report`).
 
+use crate::atomic::write_atomic;
 use crate::loop_file::Columns;
-use crate::report::{self, PageOptions};
 use crate::words::verdict;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use std::path::PathBuf;
 use stiction_core::diagnose::diagnose;
+use stiction_report::PageOptions;
 
 #[derive(clap::Args)]
 #[command(after_help = "Examples:
@@ -42,11 +44,14 @@ pub fn run(a: Args) -> Result<()> {
     let id = table.path.display().to_string();
     let d =
         diagnose(&lf.record(), &req).map_err(|e| crate::loop_messages::core_error(&id, &lf, e))?;
+    let names = a.columns.names();
     let options = PageOptions {
-        columns: Some(&a.columns),
+        columns: Some(&names),
         back_link: None,
     };
-    report::write_loop_page(&a.output, &id, &lf, &d, &options)?;
+    let html = stiction_report::loop_page(&id, &lf.data(), &d, &options)
+        .with_context(|| format!("{}: cannot render the report", a.output.display()))?;
+    write_atomic(&a.output, html.as_bytes())?;
     println!(
         "{id}: {}{}; report written to {}",
         verdict(d.verdict),

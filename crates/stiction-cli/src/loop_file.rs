@@ -10,6 +10,7 @@ use std::borrow::Cow;
 use std::path::Path;
 use stiction_core::diagnose::{DiagnoseRequest, LoopRecord};
 use stiction_core::record::{self, PrepareError};
+use stiction_report::{ColumnNames, LoopData};
 
 /// How to read a data file beyond its columns: the sheet of a workbook, the form and the zone
 /// of its times.
@@ -136,6 +137,18 @@ impl LoopFile {
         }
     }
 
+    /// The signals as the HTML pages draw them.
+    pub fn data(&self) -> LoopData<'_> {
+        LoopData {
+            op: &self.op,
+            pv: &self.pv,
+            sp: self.sp.as_deref(),
+            time: self.time.as_deref(),
+            auto: self.auto.as_deref(),
+            ts: self.ts,
+        }
+    }
+
     /// The table row of sample `k`.
     pub fn row_of(&self, k: usize) -> usize {
         self.rows.as_ref().map_or(k, |r| r[k])
@@ -200,6 +213,18 @@ impl Columns {
             ts: self.ts,
         };
         read_loop(table, &signals, &self.reading.time_spec()?)
+    }
+
+    /// The column names as a loop's page shows them in its header.
+    pub fn names(&self) -> ColumnNames {
+        ColumnNames {
+            op: self.op.clone(),
+            pv: self.pv.clone(),
+            sp: self.sp.clone(),
+            mode: self.mode.clone(),
+            time: self.time.clone(),
+            integrating: self.integrating,
+        }
     }
 
     pub fn request(&self, ts: f64) -> DiagnoseRequest {

@@ -16,9 +16,10 @@ mod human;
 mod loop_file;
 mod loop_messages;
 mod plot;
-mod report;
 mod spec;
-mod words;
+
+// the wording of verdicts, votes, numbers and durations, shared with the HTML pages
+use stiction_report::words;
 
 use clap::{CommandFactory, Parser, Subcommand};
 use exit::{Ending, Exit};

@@ -1,18 +1,27 @@
 """Benchmark: stiction.diagnose_many beside `stiction batch` and a Python loop over the CLI.
 
     python crates/stiction-py/bench/bench.py --loops 1000 --samples 2000 --threads 2 \
-        --cli target/release/stiction [--cli-loops 50] [--spark 10000]
+        --cli target/release/stiction [--cli-loops 0] [--rounds 1] \
+        [--spark 10000 [--spark-samples 2000]]
 
 Simulates LOOPS closed loops (Stenman valves with bands 0 to 4 % of span, PV noise, some with
-an external disturbance), writes each as a CSV file for `stiction batch` and the CLI loop, and
-times, with the same thread count:
+an external disturbance) into one long DataFrame, writes each loop as a CSV file for `stiction
+batch` (not timed: a batch user has the files), and times, with the same thread count THREADS:
   - stiction.diagnose_many on the long DataFrame (GIL released, rayon pool of THREADS);
   - `stiction batch DIR -o OUT --threads THREADS --sp sp` on the files;
-  - a Python loop calling `stiction diagnose FILE --sp sp --json` per loop (CLI_LOOPS of them,
-    scaled to LOOPS);
-  - optionally stiction.spark.diagnose on a local SparkSession (local[THREADS]) on SPARK loops
-    (the simulated loops repeated under new ids).
-Prints a Markdown table (loops per second and the time for LOOPS loops).
+  - a Python loop over the same DataFrame, one loop after the other: write the loop's CSV, run
+    `stiction diagnose FILE --sp sp --json` (RAYON_NUM_THREADS=THREADS, as the pool of the other
+    two), parse the JSON. CLI_LOOPS of them (0: all), scaled to LOOPS.
+ROUNDS > 1 runs the three in turn that many times (the machine's load then weighs on each
+alike) and reports each one's median. The release build of the wheel and of the CLI is the fair
+comparison (`pip install ./crates/stiction-py`, `cargo build --release -p stiction-cli`).
+
+--spark N: stiction.spark.diagnose on N loops (of SPARK_SAMPLES samples) on a local SparkSession
+(local[THREADS]) beside `stiction batch` on the same loops (one long-format CSV), and what Spark
+costs per loop: a run with a no-op function in place of the diagnosis (grouping, Arrow, the
+Python workers, task scheduling) and, inside the function, the time of diagnose_many and of the
+diagnosis itself. See spark_bench.py.
+Prints Markdown tables (loops per second, the time for LOOPS loops, the ratio to batch).
 """
 
 from __future__ import annotations
@@ -21,13 +30,13 @@ import argparse
 import json
 import os
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 import stiction
@@ -50,34 +59,39 @@ def timed(f):
     return time.perf_counter() - t0, out
 
 
-def bench_spark(frame: pd.DataFrame, loops: int, threads: int) -> tuple[float, int]:
-    from pyspark.sql import SparkSession
+def run_batch(cli: str, inputs: Path, out: Path, threads: int) -> float:
+    """`stiction batch` on a folder or a long-format file: its wall time."""
+    shutil.rmtree(out, ignore_errors=True)
+    cmd = [cli, "batch", str(inputs), "-o", str(out), "--threads", str(threads), "--sp", "sp"]
+    secs, done = timed(lambda: subprocess.run(cmd, capture_output=True, text=True))
+    if done.returncode not in (0, 3):
+        sys.exit(f"batch failed: {done.stderr}")
+    return secs
 
-    from stiction import spark as stiction_spark
 
-    os.environ.setdefault("PYSPARK_PYTHON", sys.executable)
-    spark = (
-        SparkSession.builder.master(f"local[{threads}]")
-        .appName("stiction-bench")
-        .config("spark.sql.shuffle.partitions", str(max(2, threads * 4)))
-        .config("spark.ui.enabled", "false")
-        .config("spark.sql.execution.arrow.pyspark.enabled", "true")
-        .config("spark.driver.memory", "4g")
-        .getOrCreate()
-    )
-    spark.sparkContext.setLogLevel("ERROR")
-    base = frame["loop_id"].unique()
-    reps = -(-loops // len(base))
-    big = pd.concat(
-        [frame.assign(loop_id=frame["loop_id"] + f"_{r}") for r in range(reps)], ignore_index=True
-    )
-    keep = sorted(big["loop_id"].unique())[:loops]
-    big = big[big["loop_id"].isin(set(keep))]
-    sdf = spark.createDataFrame(big).repartition(threads * 4, "loop_id").cache()
-    sdf.count()
-    secs, n = timed(lambda: stiction_spark.diagnose(sdf, sp="sp").count())
-    spark.stop()
-    return secs, n
+def cli_loop(cli: str, frame: pd.DataFrame, ids: list, scratch: Path, threads: int) -> list:
+    """What a Python user without the package does: per loop, sequentially, write its CSV, run
+    `stiction diagnose FILE --json`, parse. Returns the verdicts."""
+    env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
+    wanted = set(ids)
+    verdicts = []
+    for loop_id, g in frame.groupby("loop_id", sort=False):
+        if loop_id not in wanted:
+            continue
+        path = scratch / f"{loop_id}.csv"
+        g.drop(columns="loop_id").to_csv(path, index=False)
+        out = subprocess.run([cli, "diagnose", str(path), "--sp", "sp", "--json"], capture_output=True, text=True, check=True, env=env)
+        verdicts.append(json.loads(out.stdout)["verdict"])
+        path.unlink()
+    return verdicts
+
+
+def table(rows: list, loops: int, t_batch: float) -> None:
+    print("| how | loops timed | seconds | loops/s | time for %d loops | vs batch |" % loops)
+    print("|---|---:|---:|---:|---:|---:|")
+    for name, n, s in rows:
+        per = s / n
+        print(f"| {name} | {n} | {s:.1f} | {n / s:.1f} | {per * loops:.1f} s | {per * loops / t_batch:.2f}x |")
 
 
 def main() -> None:
@@ -86,53 +100,60 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=2000)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--cli", default=os.environ.get("STICTION_BIN", "target/release/stiction"))
-    ap.add_argument("--cli-loops", type=int, default=50)
+    ap.add_argument("--cli-loops", type=int, default=0, help="loops of the CLI loop (0: all)")
+    ap.add_argument("--rounds", type=int, default=1, help="run the three in turn this many times; medians")
     ap.add_argument("--spark", type=int, default=0, help="loops for the Spark run (0: skip)")
+    ap.add_argument("--spark-samples", type=int, default=0, help="samples per Spark loop (default: --samples)")
     a = ap.parse_args()
+    work = Path(tempfile.mkdtemp(prefix="stiction-bench-"))
+    try:
+        if a.loops:
+            bench_fleet(a, work)
+        if a.spark:
+            import spark_bench
 
+            spark_bench.run(a, work, fleet, run_batch, table)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def bench_fleet(a: argparse.Namespace, work: Path) -> None:
     secs, frame = timed(lambda: fleet(a.loops, a.samples))
     print(f"simulated {a.loops} loops x {a.samples} samples in {secs:.1f} s", file=sys.stderr)
-    work = Path(tempfile.mkdtemp(prefix="stiction-bench-"))
     files = work / "loops"
     files.mkdir()
     for loop_id, g in frame.groupby("loop_id", sort=False):
         g.drop(columns="loop_id").to_csv(files / f"{loop_id}.csv", index=False)
-    rows = []
-
-    t_many, many = timed(lambda: stiction.diagnose_many(frame, sp="sp", threads=a.threads, progress=False))
-    rows.append(("stiction.diagnose_many (DataFrame)", a.loops, t_many))
-
-    out = work / "batch"
-    cmd = [a.cli, "batch", str(files), "-o", str(out), "--threads", str(a.threads), "--sp", "sp"]
-    t_batch, done = timed(lambda: subprocess.run(cmd, capture_output=True, text=True))
-    if done.returncode not in (0, 3):
-        sys.exit(f"batch failed: {done.stderr}")
-    rows.append(("stiction batch (CSV files)", a.loops, t_batch))
-
-    subset = sorted(files.glob("*.csv"))[: a.cli_loops]
-
-    def cli_loop():
-        for f in subset:
-            json.loads(subprocess.run([a.cli, "diagnose", str(f), "--sp", "sp", "--json"], capture_output=True, text=True, check=True).stdout)
-
-    t_cli, _ = timed(cli_loop)
-    rows.append((f"Python loop over `stiction diagnose --json` ({len(subset)} loops, scaled)", len(subset), t_cli))
-
-    if a.spark:
-        t_spark, n = bench_spark(frame, a.spark, a.threads)
-        rows.append((f"stiction.spark.diagnose, local[{a.threads}]", n, t_spark))
-
-    # the same answers: diagnose_many's rows against batch's summary
-    summary = pd.read_csv(out / "summary.csv")
-    same = (summary.set_index("loop_id")["verdict"].sort_index() == many.set_index("loop_id")["verdict"].sort_index()).all()
-
-    print(f"\n{a.loops} loops x {a.samples} samples, {a.threads} threads, {os.cpu_count()} cores; verdicts of diagnose_many and batch identical: {same}\n")
-    print("| how | loops timed | seconds | loops/s | time for %d loops | vs batch |" % a.loops)
-    print("|---|---:|---:|---:|---:|---:|")
-    for name, n, s in rows:
-        per = s / n
-        print(f"| {name} | {n} | {s:.1f} | {n / s:.1f} | {per * a.loops:.1f} s | {per * a.loops / t_batch:.2f}x |")
-    shutil.rmtree(work, ignore_errors=True)
+    scratch = work / "cli"
+    scratch.mkdir()
+    ids = sorted(frame["loop_id"].unique())
+    subset = ids if a.cli_loops <= 0 else ids[:: max(1, len(ids) // a.cli_loops)][: a.cli_loops]
+    times = {"many": [], "batch": [], "cli": []}
+    for r in range(a.rounds):
+        t, many = timed(lambda: stiction.diagnose_many(frame, sp="sp", threads=a.threads, progress=False))
+        times["many"].append(t)
+        times["batch"].append(run_batch(a.cli, files, work / "batch", a.threads))
+        t, cli_verdicts = timed(lambda: cli_loop(a.cli, frame, subset, scratch, a.threads))
+        times["cli"].append(t)
+        print(f"round {r + 1}: diagnose_many {times['many'][-1]:.1f} s, batch {times['batch'][-1]:.1f} s, "
+              f"CLI loop {t:.1f} s ({len(subset)} loops)", file=sys.stderr)
+    med = {k: statistics.median(v) for k, v in times.items()}
+    # the same answers: diagnose_many's rows against batch's summary and the CLI's JSON
+    summary = pd.read_csv(work / "batch" / "summary.csv").set_index("loop_id")["verdict"].sort_index()
+    ours = many.set_index("loop_id")["verdict"].sort_index()
+    same = bool((summary == ours).all()) and list(ours.loc[subset]) == cli_verdicts
+    rows = [
+        ("stiction.diagnose_many (one long DataFrame)", a.loops, med["many"]),
+        ("stiction batch (a CSV file per loop)", a.loops, med["batch"]),
+        (f"Python loop: write CSV, `stiction diagnose FILE --json`, parse ({len(subset)} loops)", len(subset), med["cli"]),
+    ]
+    load = os.getloadavg()
+    print(f"\n{a.loops} loops x {a.samples} samples, {a.threads} threads, {os.cpu_count()} cores, "
+          f"{a.rounds} round(s) (medians); load average {load[0]:.1f}; verdicts identical in all three: {same}")
+    per_round = [f"{m / b:.2f}x / {c * a.loops / len(subset) / m:.1f}x"
+                 for m, b, c in zip(times["many"], times["batch"], times["cli"])]
+    print("diagnose_many vs batch / CLI loop vs diagnose_many, per round: " + ", ".join(per_round) + "\n")
+    table(rows, a.loops, med["batch"])
 
 
 if __name__ == "__main__":

@@ -1,12 +1,14 @@
 //! `stiction._stiction`: the native half of the Python package. Thin conversion only: numpy
 //! arrays are read as the core's slices (without copies when contiguous), the core's result
 //! structs go back as the same serde JSON the CLI prints (so `to_dict()` equals `--json` key
-//! for key), and the core's errors become `StictionError` (a `ValueError`) with one sentence
+//! for key), a loop's HTML report is `stiction-report`'s page (as `stiction report` writes it),
+//! and the core's errors become `StictionError` (a `ValueError`) with one sentence
 //! naming the argument and the fix. The pandas side lives in `python/stiction/`.
 
 mod diagnose;
 mod fit;
 mod many;
+mod report;
 mod sim;
 
 use numpy::PyReadonlyArray1;
@@ -97,6 +99,7 @@ fn _stiction(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parse_numbers, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(many::diagnose_many, m)?)?;
+    m.add_function(wrap_pyfunction!(report::report, m)?)?;
     m.add_function(wrap_pyfunction!(fit::quantify, m)?)?;
     m.add_function(wrap_pyfunction!(fit::estimate, m)?)?;
     m.add_function(wrap_pyfunction!(sim::simulate, m)?)?;

@@ -1,11 +1,11 @@
 //! `index.html` for `--reports`: every loop ranked as in summary.csv, linking its report, with a
-//! sparkline of PV and OP; the page itself is [`crate::report::fleet`]'s.
+//! sparkline of PV and OP; the page itself is [`stiction_report::fleet`]'s.
 
 use super::summary::{Row, SourceStatus};
 use crate::atomic::write_atomic;
-use crate::report::fleet::{self, Entry};
 use anyhow::Result;
 use std::path::Path;
+use stiction_report::fleet::{self, Entry};
 
 /// Write `index.html` into `outdir`: the rows in their (ranked) order.
 pub fn write_index(outdir: &Path, rows: &[Row], complete: bool) -> Result<()> {

@@ -14,8 +14,6 @@ use super::summary::{self, Fate, Row, SourceStatus};
 use crate::atomic::write_atomic;
 use crate::data::Table;
 use crate::loop_file::{Columns, LoopFile};
-use crate::report::fleet::Spark;
-use crate::report::{self, PageOptions};
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -23,6 +21,8 @@ use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 use stiction_core::diagnose::{diagnose, Diagnosis};
 use stiction_core::fleet;
+use stiction_report::fleet::Spark;
+use stiction_report::PageOptions;
 
 /// What every worker needs.
 pub struct Ctx {
@@ -218,11 +218,12 @@ fn read_loop(loaded: Loaded, columns: &Columns) -> Result<LoopFile, String> {
 
 /// The loop's full report (`stiction report`), with a link back to the fleet's index page.
 fn render_report(loop_id: &str, lf: &LoopFile, d: &Diagnosis, columns: &Columns) -> Result<String> {
+    let names = columns.names();
     let options = PageOptions {
-        columns: Some(columns),
+        columns: Some(&names),
         back_link: Some(("../index.html".into(), "all loops".into())),
     };
-    report::loop_page(loop_id, lf, d, &options)
+    stiction_report::loop_page(loop_id, &lf.data(), d, &options)
 }
 
 /// Diagnose one loop: never panics, never fails the batch; a loop that cannot be read or

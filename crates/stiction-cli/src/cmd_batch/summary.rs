@@ -2,12 +2,12 @@
 //! core's [`fleet::ranking`]), written to summary.csv and summary.json.
 
 use crate::atomic::write_with;
-use crate::report::fleet::Spark;
 use anyhow::Result;
 use serde::Serialize;
 use std::borrow::Cow;
 use std::path::Path;
 use stiction_core::fleet::{self, Counts};
+use stiction_report::fleet::Spark;
 
 /// Whether the input a row was diagnosed from is still among the inputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]

@@ -3,8 +3,8 @@
 The same core as the ``stiction`` command: diagnose routine loop data (``diagnose``), quantify
 the stiction band from OP and PV (``quantify``), estimate a stiction model from OP and the valve
 position (``estimate``), simulate sticky valves (``simulate``, ``Stenman``, ``He``, ``Kano``,
-``Choudhury``), and diagnose a fleet in parallel (``diagnose_many``; ``stiction.spark`` for
-Spark). Results equal the CLI's ``--json`` key for key (``to_dict()``).
+``Choudhury``), write a loop's HTML report (``report``, the page of ``stiction report``), and
+diagnose a fleet in parallel (``diagnose_many``; ``stiction.spark`` for Spark). Results equal the CLI's ``--json`` key for key (``to_dict()``).
 
 Bad input raises :class:`StictionError`, a ``ValueError`` with one sentence naming the argument,
 column or row and the fix.
@@ -19,6 +19,7 @@ import pandas as pd
 
 from . import _stiction as _native
 from ._many import FLEET_COLUMNS, diagnose_many
+from ._report import report
 from ._results import Diagnosis, Estimate, Quantification
 from ._signals import StictionError, loop_columns, numbers
 from ._stiction import Choudhury, He, Kano, Stenman
@@ -39,6 +40,7 @@ __all__ = [
     "diagnose_many",
     "estimate",
     "quantify",
+    "report",
     "simulate",
 ]
 

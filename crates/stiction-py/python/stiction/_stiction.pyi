@@ -29,6 +29,28 @@ def diagnose(
     estimate_start: bool = False,
     time_name: Optional[str] = None,
 ) -> Tuple[str, List[str]]: ...
+def report(
+    op: npt.NDArray[np.float64],
+    pv: npt.NDArray[np.float64],
+    sp: Optional[npt.NDArray[np.float64]] = None,
+    mv: Optional[npt.NDArray[np.float64]] = None,
+    auto: Optional[npt.NDArray[np.bool_]] = None,
+    time: Optional[npt.NDArray[np.float64]] = None,
+    ts: Optional[float] = None,
+    integrating: bool = False,
+    window: Optional[int] = None,
+    quantify: bool = True,
+    op_range: Tuple[float, float] = (0.0, 100.0),
+    estimate_start: bool = False,
+    time_name: Optional[str] = None,
+    loop_id: str = "loop",
+    columns: Optional[Dict[str, str]] = None,
+) -> str:
+    """Diagnose one loop and render its report, the page ``stiction report`` writes (the same
+    Rust code), as HTML text. loop_id: the loop's name in the title; columns: the names of the
+    op, pv, sp, mode and time columns for the header (op and pv needed), or None. Bad input
+    raises StictionError; ``stiction.report`` writes the page to a file."""
+
 def diagnose_many(
     ids: List[str],
     sources: List[str],

@@ -1,6 +1,8 @@
-//! The HTML pages: a loop's report (`stiction report`, and each loop's page of `stiction batch
-//! --reports`) and the fleet's index page, rendered from minijinja templates (`templates/`,
-//! embedded in the binary) with one stylesheet (`style.css`) and the words of [`crate::words`].
+//! The HTML pages of stiction: a loop's report (`stiction report`, each loop's page of `stiction
+//! batch --reports`, and `stiction.report` in Python) and the fleet's index page, rendered from
+//! minijinja templates (`templates/`, embedded in the library) with one stylesheet (`style.css`)
+//! and the words of [`words`]. The CLI and the Python package both call [`loop_page`], so the
+//! same loop gives the same page whichever front end wrote it.
 //!
 //! Each page is self-contained: inline CSS, inline SVG charts, no fonts, images or scripts from
 //! elsewhere (the fleet page carries a few lines of inline script to sort and filter). Every text
@@ -9,19 +11,18 @@
 //! The context of a page is built first as plain serialisable structs ([`context`], [`sections`],
 //! [`fleet`]); the templates only lay it out.
 
+pub mod chart;
 mod context;
 pub mod fleet;
 mod plots;
 mod sections;
 mod series;
+pub mod words;
 
 pub use context::Link;
 
-use crate::atomic::write_atomic;
-use crate::loop_file::{Columns, LoopFile};
-use anyhow::{Context as _, Result};
+use anyhow::Result;
 use minijinja::{AutoEscape, Environment, Value};
-use std::path::Path;
 use std::sync::OnceLock;
 use stiction_core::diagnose::Diagnosis;
 
@@ -35,11 +36,37 @@ const TEMPLATES: [(&str, &str); 4] = [
     ("fleet.html", include_str!("templates/fleet.html")),
 ];
 
+/// A loop's signals as the diagnosis read them (after the record's preparation: rows in time
+/// order, gaps as NaN in op, pv and sp, not automatic in `auto`).
+#[derive(Clone, Copy)]
+pub struct LoopData<'a> {
+    pub op: &'a [f64],
+    pub pv: &'a [f64],
+    pub sp: Option<&'a [f64]>,
+    /// Seconds, when the record had a time axis (else sample k is at k * ts).
+    pub time: Option<&'a [f64]>,
+    pub auto: Option<&'a [bool]>,
+    /// Sampling time, seconds.
+    pub ts: f64,
+}
+
+/// The names of the columns a loop was read from, for the page's header.
+#[derive(Clone, Debug, Default)]
+pub struct ColumnNames {
+    pub op: String,
+    pub pv: String,
+    pub sp: Option<String>,
+    pub mode: Option<String>,
+    /// The time column when it was named; `None` with a time axis says it was found by its name.
+    pub time: Option<String>,
+    pub integrating: bool,
+}
+
 /// How a loop's page is rendered beyond its data.
 #[derive(Default)]
 pub struct PageOptions<'a> {
     /// The columns the loop was read from, named in the header when known.
-    pub columns: Option<&'a Columns>,
+    pub columns: Option<&'a ColumnNames>,
     /// A link above the title: (href, text), e.g. batch's `("../index.html", "all loops")`.
     pub back_link: Option<(String, String)>,
 }
@@ -95,24 +122,12 @@ fn render_template(name: &str, ctx: impl serde::Serialize) -> Result<String> {
         .map_err(|e| anyhow::anyhow!("the {name} template: {e:#}"))
 }
 
-/// A loop's report as one HTML document. `loop_id` names the loop in the title (a file name or
-/// tag).
-pub fn loop_page(loop_id: &str, lf: &LoopFile, d: &Diagnosis, o: &PageOptions) -> Result<String> {
-    let ctx = context::build(loop_id, lf, d, o)?;
+/// A loop's report as one HTML document: `data` the signals the diagnosis `d` read, `loop_id`
+/// names the loop in the title (a file name or tag). The only parts that change from run to run
+/// of the same loop are the times the diagnosis and the estimate took.
+pub fn loop_page(loop_id: &str, data: &LoopData, d: &Diagnosis, o: &PageOptions) -> Result<String> {
+    let ctx = context::build(loop_id, data, d, o)?;
     render_template("report.html", ctx)
-}
-
-/// Write a loop's report to `path` (atomically: a temporary file, then a rename).
-pub fn write_loop_page(
-    path: &Path,
-    loop_id: &str,
-    lf: &LoopFile,
-    d: &Diagnosis,
-    o: &PageOptions,
-) -> Result<()> {
-    let html = loop_page(loop_id, lf, d, o)
-        .with_context(|| format!("{}: cannot render the report", path.display()))?;
-    write_atomic(path, html.as_bytes())
 }
 
 #[cfg(test)]

@@ -6,8 +6,8 @@ use super::plots::{self, Figure, PHASE_SIZE, TREND_SIZE};
 use super::sections::{self, Estimates, Evidence, KvRow, Notes, Quality, Windows};
 use super::series::{self, LONG_RECORD};
 use super::PageOptions;
-use crate::loop_file::{Columns, LoopFile};
 use crate::words::{capital, duration, num, verdict};
+use crate::{ColumnNames, LoopData};
 use anyhow::Result;
 use serde::Serialize;
 use stiction_core::diagnose::Diagnosis;
@@ -122,13 +122,13 @@ const PHASE_POINTS: usize = 6000;
 /// Buckets enough to keep every sample of a zoom window (at most 2000).
 const EVERY_SAMPLE: usize = 1 << 20;
 
-pub fn build(loop_id: &str, lf: &LoopFile, d: &Diagnosis, o: &PageOptions) -> Result<Report> {
+pub fn build(loop_id: &str, data: &LoopData, d: &Diagnosis, o: &PageOptions) -> Result<Report> {
     let q = d
         .quantification
         .as_ref()
         .filter(|q| q.status == QuantifyStatus::Ok);
-    let zoom = if lf.op.len() > LONG_RECORD {
-        Some(zoom(lf, d, q)?)
+    let zoom = if data.op.len() > LONG_RECORD {
+        Some(zoom(data, d, q)?)
     } else {
         None
     };
@@ -141,13 +141,13 @@ pub fn build(loop_id: &str, lf: &LoopFile, d: &Diagnosis, o: &PageOptions) -> Re
             href: href.clone(),
             text: text.clone(),
         }),
-        meta: meta(lf, d),
-        columns: o.columns.map(|c| columns(c, lf)).unwrap_or_default(),
+        meta: meta(data, d),
+        columns: o.columns.map(|c| columns(c, data)).unwrap_or_default(),
         toc: toc(d, zoom.is_some()),
         verdict: verdict_box(d),
-        trends: trends(lf, d, q)?,
+        trends: trends(data, d, q)?,
         zoom,
-        phase: phase(lf, d, q)?,
+        phase: phase(data, d, q)?,
         evidence: sections::evidence(d),
         oscillation: sections::oscillation(d),
         estimates: sections::estimates(d, q),
@@ -159,19 +159,19 @@ pub fn build(loop_id: &str, lf: &LoopFile, d: &Diagnosis, o: &PageOptions) -> Re
     })
 }
 
-fn meta(lf: &LoopFile, d: &Diagnosis) -> String {
+fn meta(data: &LoopData, d: &Diagnosis) -> String {
     let [s, e] = d.analysed;
     format!(
         "{} samples at {} s, {} in all; analysed samples {s} to {e}{}{}.",
         d.samples,
         num(d.ts),
         duration(d.samples as f64 * d.ts),
-        if lf.auto.is_some() {
+        if data.auto.is_some() {
             ", in automatic"
         } else {
             ""
         },
-        if lf.sp.is_some() {
+        if data.sp.is_some() {
             " with a constant setpoint"
         } else {
             ""
@@ -179,7 +179,7 @@ fn meta(lf: &LoopFile, d: &Diagnosis) -> String {
     )
 }
 
-fn columns(c: &Columns, lf: &LoopFile) -> Vec<Rich> {
+fn columns(c: &ColumnNames, data: &LoopData) -> Vec<Rich> {
     let mut parts = vec![rich("OP ").code(&c.op), rich("PV ").code(&c.pv)];
     if let Some(sp) = &c.sp {
         parts.push(rich("SP ").code(sp));
@@ -187,7 +187,7 @@ fn columns(c: &Columns, lf: &LoopFile) -> Vec<Rich> {
     if let Some(m) = &c.mode {
         parts.push(rich("mode ").code(m));
     }
-    match (&c.time, &lf.time) {
+    match (&c.time, &data.time) {
         (Some(t), _) => parts.push(rich("time ").code(t)),
         (None, Some(_)) => parts.push(rich("time column found by its name")),
         (None, None) => {}
@@ -252,7 +252,7 @@ fn verdict_box(d: &Diagnosis) -> VerdictBox {
 /// The PV chart (with SP and the simulated PV) and the OP chart (with the estimated valve) over
 /// the samples `[a, b)`, `buckets` decimation buckets each.
 fn trend_pair(
-    lf: &LoopFile,
+    data: &LoopData,
     d: &Diagnosis,
     q: Option<&Quantification>,
     [a, b]: [usize; 2],
@@ -261,7 +261,7 @@ fn trend_pair(
     if b <= a {
         return Ok(vec![]);
     }
-    let t = series::time_axis(lf);
+    let t = series::time_axis(data);
     let (unit, per) = series::time_unit(t[b - 1] - t[a]);
     let x_label = format!("time ({unit})");
     let tu: Vec<f64> = t[a..b].iter().map(|v| v / per).collect();
@@ -272,8 +272,8 @@ fn trend_pair(
         (s < e && e <= t.len() && v.len() == e - s && s2 < e2)
             .then(|| series::decimate(&tu[s2 - a..e2 - a], &v[s2 - s..e2 - s], buckets))
     };
-    let pv = series::decimate(&tu, &lf.pv[a..b], buckets);
-    let sp = lf
+    let pv = series::decimate(&tu, &data.pv[a..b], buckets);
+    let sp = data
         .sp
         .as_ref()
         .map(|sp| series::decimate(&tu, &sp[a..b], buckets));
@@ -301,7 +301,7 @@ fn trend_pair(
         TREND_SIZE,
         caption,
     )?;
-    let op = series::decimate(&tu, &lf.op[a..b], buckets);
+    let op = series::decimate(&tu, &data.op[a..b], buckets);
     let mut traces = vec![plots::line("OP", &op, 0)];
     if let Some(mv) = &mv {
         traces.push(plots::steps("estimated MV", mv, 1));
@@ -320,15 +320,15 @@ fn trend_pair(
     Ok(vec![pv_fig, op_fig])
 }
 
-fn trends(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Trends> {
-    let n = lf.op.len();
+fn trends(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Trends> {
+    let n = data.op.len();
     let overview = n > LONG_RECORD;
     let buckets = if overview {
         OVERVIEW_BUCKETS
     } else {
         TREND_BUCKETS
     };
-    let mut figures = trend_pair(lf, d, q, [0, n], buckets)?;
+    let mut figures = trend_pair(data, d, q, [0, n], buckets)?;
     if overview {
         for f in &mut figures {
             f.caption = format!(
@@ -339,7 +339,7 @@ fn trends(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Tr
         }
     }
     let [s, e] = d.quantified.unwrap_or(d.analysed);
-    let t = series::time_axis(lf);
+    let t = series::time_axis(data);
     let note = (s > 0 || e < d.samples).then(|| {
         format!(
             "The diagnosis uses samples {s} to {e} (t = {} to {} s); the rest of the record is in \
@@ -357,8 +357,8 @@ fn trends(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Tr
 
 /// The window of a long record where OP and PV vary most, inside the analysed stretch, at full
 /// resolution.
-fn zoom(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Zoom> {
-    let n = lf.op.len();
+fn zoom(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Zoom> {
+    let n = data.op.len();
     let [s, e] = d.analysed;
     let (s, e) = if s < e && e <= n { (s, e) } else { (0, n) };
     let period = d
@@ -367,10 +367,10 @@ fn zoom(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Zoom
         .and_then(|o| o.period)
         .map(|p| p / d.ts);
     let len = series::zoom_length(period, e - s);
-    let a = s + series::busiest_window(&lf.op[s..e], &lf.pv[s..e], len);
+    let a = s + series::busiest_window(&data.op[s..e], &data.pv[s..e], len);
     let b = a + len;
-    let t = series::time_axis(lf);
-    let figures = trend_pair(lf, d, q, [a, b], EVERY_SAMPLE)?;
+    let t = series::time_axis(data);
+    let figures = trend_pair(data, d, q, [a, b], EVERY_SAMPLE)?;
     let why = match period {
         Some(p) if 5.0 * p >= 300.0 && 5.0 * p <= 2000.0 => "five periods of the oscillation",
         Some(_) => "about five periods of the oscillation, kept between 300 and 2000 samples",
@@ -393,15 +393,15 @@ fn zoom(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Zoom
     })
 }
 
-fn phase(lf: &LoopFile, d: &Diagnosis, q: Option<&Quantification>) -> Result<Figure> {
+fn phase(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Figure> {
     let [s, e] = d.quantified.unwrap_or(d.analysed);
-    let (s, e) = if s + 1 < e && e <= lf.op.len() {
+    let (s, e) = if s + 1 < e && e <= data.op.len() {
         (s, e)
     } else {
-        (0, lf.op.len())
+        (0, data.op.len())
     };
-    let op = series::thin(&lf.op[s..e], PHASE_POINTS);
-    let measured = (op.clone(), series::thin(&lf.pv[s..e], PHASE_POINTS));
+    let op = series::thin(&data.op[s..e], PHASE_POINTS);
+    let measured = (op.clone(), series::thin(&data.pv[s..e], PHASE_POINTS));
     let sim = q
         .filter(|q| q.pv_simulated.len() == e - s)
         .map(|q| (op.clone(), series::thin(&q.pv_simulated, PHASE_POINTS)));

@@ -2,7 +2,7 @@
 //! relatively larger) for phones; the stylesheet shows one. The data come prepared (decimated,
 //! thinned, windowed) from [`super::series`]: nothing here computes.
 
-use crate::plot::{self, Chart, Kind, Series};
+use crate::chart::{self as plot, Chart, Kind, Series};
 use anyhow::Result;
 use serde::Serialize;
 

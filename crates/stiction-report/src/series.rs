@@ -2,16 +2,16 @@
 //! min/max decimation for long traces, thinning for the phase plot, and the zoom window of a long
 //! record (the stretch where OP and PV vary most).
 
-use crate::loop_file::LoopFile;
+use crate::LoopData;
 
 /// A record longer than this many samples gets an overview (decimated) and a zoomed window.
 pub const LONG_RECORD: usize = 5000;
 
 /// Seconds from the first sample for every sample of the record.
-pub fn time_axis(lf: &LoopFile) -> Vec<f64> {
-    match &lf.time {
+pub fn time_axis(data: &LoopData) -> Vec<f64> {
+    match &data.time {
         Some(t) if !t.is_empty() => t.iter().map(|v| v - t[0]).collect(),
-        _ => (0..lf.op.len()).map(|k| k as f64 * lf.ts).collect(),
+        _ => (0..data.op.len()).map(|k| k as f64 * data.ts).collect(),
     }
 }
 

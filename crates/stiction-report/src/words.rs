@@ -1,6 +1,6 @@
-//! Small pieces of the CLI's own wording: counts with the right plural, seconds rounded for a
+//! Small pieces of stiction's wording: counts with the right plural, seconds rounded for a
 //! person to read, numbers as the report prints them, and each verdict, outcome and vote named
-//! once for the terminal, the loop report and the fleet page.
+//! once for the terminal (the CLI uses this module), the loop report and the fleet page.
 
 use stiction_core::diagnose::{Verdict, Vote};
 use stiction_core::fleet::Outcome;
