@@ -3,7 +3,7 @@ use crate::words::count;
 use crate::{atomic::write_atomic, data, spec};
 use anyhow::{bail, Result};
 use std::path::PathBuf;
-use stiction_core::estimate::{self, Estimate, EstimateError, IntervalKind, Method, Request};
+use stiction_core::estimate::{self, Estimate, IntervalKind, Method, Request};
 use stiction_core::models::ModelKind;
 
 #[derive(clap::Args)]
@@ -109,7 +109,7 @@ pub fn run(a: Args) -> Result<()> {
         bail!("--trace: the {method} method has no iterations to trace; use --method aco or aco-r");
     }
     // settings and bounds are checked before the file is read, so a typo fails fast
-    req.check_settings().map_err(flag_error)?;
+    req.check_settings().map_err(spec::setting_error)?;
     req.resolved_bounds().map_err(|e| anyhow::anyhow!("{e}"))?;
 
     let table = a.reading.open(&a.file)?;
@@ -123,7 +123,7 @@ pub fn run(a: Args) -> Result<()> {
     )?;
     let name = table.path.display().to_string();
     let est = estimate::estimate(&pair.a, &pair.b, &req)
-        .map_err(|e| anyhow::anyhow!("{name}: {}", flag_error(e)))?;
+        .map_err(|e| anyhow::anyhow!("{name}: {}", spec::setting_error(e)))?;
     if let Some(path) = &a.trace {
         write_trace(path, kind, &est)?;
     }
@@ -144,26 +144,6 @@ pub fn run(a: Args) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// The core names a method's setting as its settings do; the user set it with a flag, so the
-/// message names the flag (ACO_R's `q` is `--locality` here, ACO's `--q`).
-fn flag_error(e: EstimateError) -> anyhow::Error {
-    match e {
-        EstimateError::Setting {
-            method,
-            name,
-            rule,
-            value,
-        } => {
-            let flag = match (method, name) {
-                (Method::AcoR, "q") => "locality".to_string(),
-                _ => name.replace('_', "-"),
-            };
-            anyhow::anyhow!("--{flag} must be {rule}, got {value}")
-        }
-        e => e.into(),
-    }
 }
 
 fn bounds(kind: ModelKind, a: &Args) -> Result<Option<Vec<(f64, f64)>>> {

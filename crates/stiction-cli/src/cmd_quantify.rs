@@ -141,7 +141,8 @@ pub fn run(a: Args) -> Result<()> {
         )?;
         req.bounds = Some(b);
     }
-    let q = quantify(&op, &pv, &req).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    let q = quantify(&op, &pv, &req)
+        .map_err(|e| anyhow::anyhow!("{name}: {}", spec::setting_error(e)))?;
     let notes: Vec<&String> = stretch.note.iter().chain(&lf.notes).collect();
 
     if let Some(dir) = &a.plot {

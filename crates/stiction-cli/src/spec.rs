@@ -2,6 +2,7 @@
 //! processes (`foptd:K=3,tau=10,delay=10`), model parameters.
 
 use anyhow::{bail, Context, Result};
+use stiction_core::estimate::{EstimateError, Method};
 use stiction_core::models::{Model, ModelKind};
 use stiction_core::sim::{Pi, Process, Signal};
 use stiction_core::spec as core_spec;
@@ -93,5 +94,25 @@ impl FitArgs {
             );
         }
         Ok((kind, method))
+    }
+}
+
+/// A search setting out of range, in the words of the flag that sets it (`--ants must be at
+/// least 1, got 0`; ACO_R's `q` is `--locality`, ACO's `--q`); other estimate errors as they are.
+pub fn setting_error(e: EstimateError) -> anyhow::Error {
+    match e {
+        EstimateError::Setting {
+            method,
+            name,
+            rule,
+            value,
+        } => {
+            let flag = match (method, name) {
+                (Method::AcoR, "q") => "locality".to_string(),
+                _ => name.replace('_', "-"),
+            };
+            anyhow::anyhow!("--{flag} must be {rule}, got {value}")
+        }
+        e => e.into(),
     }
 }

@@ -488,6 +488,11 @@ fn quantify_from_op_and_pv_json_and_plots() {
         plots.to_str().unwrap(),
     ]));
     assert_eq!(v["status"], "ok");
+    // a search setting out of range is the flag's sentence, as in estimate (it was a panic)
+    fails(
+        &["quantify", &f, "--method", "aco", "--ants", "0"],
+        &["--ants must be at least 1, got 0"],
+    );
     for key in [
         "model",
         "method",

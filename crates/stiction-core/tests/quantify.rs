@@ -248,3 +248,12 @@ fn an_unstable_linear_fit_gives_no_r2_without_stiction() {
         f.r2_simulation_without_stiction
     );
 }
+
+#[test]
+fn a_search_setting_out_of_range_is_an_error_naming_it() {
+    let (op, _, pv) = sticky_loop(1.0, 0.02, 4);
+    let mut req = QuantifyRequest::new(ModelKind::Stenman, Method::Aco);
+    req.aco.ants = 0;
+    let e = quantify(&op, &pv, &req).unwrap_err().to_string();
+    assert_eq!(e, "aco ants must be at least 1, got 0");
+}

@@ -48,6 +48,16 @@ const STAGE_PERIODS: f64 = 8.0;
 /// ... when the record has at least this many samples.
 const STAGE_FROM: usize = 1500;
 
+/// The search's settings as an estimate request, to check them as `estimate` does (an ant count
+/// of 0 is an error naming the setting, not a failed search).
+fn settings_request(req: &QuantifyRequest) -> crate::estimate::Request {
+    let mut r = crate::estimate::Request::new(req.model, req.method);
+    r.aco = req.aco.clone();
+    r.acor = req.acor.clone();
+    r.grid = req.grid.clone();
+    r
+}
+
 /// Quantify stiction from OP and PV. Data that cannot be judged gives `status: insufficient_data`
 /// with the reason; requests that are wrong (bounds, settings) give an error.
 ///
@@ -73,6 +83,7 @@ pub fn quantify(
     req: &QuantifyRequest,
 ) -> Result<Quantification, EstimateError> {
     let started = Instant::now();
+    settings_request(req).check_settings()?;
     let n = op.len();
     if !(req.model == ModelKind::Stenman && req.method == Method::Exact && pv.len() == n) {
         return quantify_inner(op, pv, req, None).map(|r| r.0);
