@@ -86,7 +86,12 @@ def worker_gaps(parts: pd.DataFrame) -> float:
 
 
 def run(a, work, fleet, run_batch, table) -> None:
+    from pyspark import cloudpickle
+
     from stiction import spark as stiction_spark
+
+    # noop and instrumented go to the Python workers by value: this module is not importable there
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])
 
     n, samples, threads = a.spark, a.spark_samples or a.samples, a.threads
     secs, frame = _timed(lambda: fleet(n, samples))
