@@ -5,7 +5,7 @@ use crate::{bad, json, slice, slice_bool};
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use stiction_core::diagnose::{self as core, DiagnoseError, DiagnoseRequest, Diagnosis};
-use stiction_core::record::{self, PrepareError, Signals};
+use stiction_core::record::{self, PrepareError, Prepared, Signals};
 
 /// What every diagnosis is asked besides the signals (the CLI's column flags).
 #[derive(Clone, Debug)]
@@ -36,7 +36,7 @@ impl Settings {
 }
 
 /// The core's preparation error in one sentence naming the argument.
-pub fn prepare_error(e: PrepareError, s: &Settings) -> String {
+fn prepare_error(e: PrepareError, s: &Settings) -> String {
     match e {
         PrepareError::Ts(ts) => {
             format!("ts={ts}: the sampling time must be a positive number of seconds")
@@ -51,7 +51,7 @@ pub fn prepare_error(e: PrepareError, s: &Settings) -> String {
 
 /// The core's diagnosis error in one sentence naming the argument (the CLI's `core_error`, with
 /// keyword arguments for flags).
-pub fn diagnose_error(e: DiagnoseError) -> String {
+fn diagnose_error(e: DiagnoseError) -> String {
     match e {
         DiagnoseError::Window { window, least } => format!(
             "window={window}: a window needs at least {least} samples; give a larger window"
@@ -66,11 +66,12 @@ pub fn diagnose_error(e: DiagnoseError) -> String {
     }
 }
 
-/// Prepare and diagnose one loop: the diagnosis and the notes, or one sentence.
-pub fn run(signals: Signals<'_>, s: &Settings) -> Result<(Diagnosis, Vec<String>), String> {
+/// Prepare and diagnose one loop: the diagnosis and the prepared record (its signals in time
+/// order, sampling time and notes), or one sentence.
+pub fn run<'a>(signals: Signals<'a>, s: &Settings) -> Result<(Diagnosis, Prepared<'a>), String> {
     let p = record::prepare(signals, s.ts).map_err(|e| prepare_error(e, s))?;
     let d = core::diagnose(&p.signals.record(), &s.request(p.ts)).map_err(diagnose_error)?;
-    Ok((d, p.notes))
+    Ok((d, p))
 }
 
 /// Diagnose one loop: the `Diagnosis` as JSON (the CLI's `diagnose --json`) and the notes of
@@ -112,6 +113,6 @@ pub fn diagnose(
         auto: auto.as_ref().map(slice_bool),
         time: time.as_ref().map(slice),
     };
-    let (d, notes) = py.detach(|| run(signals, &settings)).map_err(bad)?;
-    Ok((json(&d)?, notes))
+    let (d, p) = py.detach(|| run(signals, &settings)).map_err(bad)?;
+    Ok((json(&d)?, p.notes))
 }

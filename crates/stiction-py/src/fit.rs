@@ -7,10 +7,30 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::borrow::Cow;
 use std::collections::HashMap;
-use stiction_core::estimate::{self as core_estimate, Method, Request};
+use stiction_core::estimate::{self as core_estimate, EstimateError, Method, Request};
 use stiction_core::models::ModelKind;
 use stiction_core::quantify::{self as core_quantify, QuantifyRequest};
 use stiction_core::record::{self, longest_clean, PrepareError, Signals};
+
+/// The core's error in one sentence; a method's setting out of range is named by its keyword
+/// (ACO_R's `q` is `locality=`), as the CLI names its flag.
+fn estimate_error(e: EstimateError) -> PyErr {
+    match e {
+        EstimateError::Setting {
+            method,
+            name,
+            rule,
+            value,
+        } => {
+            let key = match (method, name) {
+                (Method::AcoR, "q") => "locality",
+                _ => name,
+            };
+            bad(format!("{key}={value}: {key} must be {rule}"))
+        }
+        e => bad(e.to_string()),
+    }
+}
 
 /// The model and method, checked (exact is for Stenman only), as the CLI's `--model/--method`.
 fn model_method(model: &str, method: Option<&str>) -> PyResult<(ModelKind, Method)> {
@@ -165,7 +185,7 @@ pub fn quantify(
     }
     let q = py
         .detach(|| core_quantify::quantify(op, pv, &req))
-        .map_err(|e| bad(e.to_string()))?;
+        .map_err(estimate_error)?;
     let notes = note.into_iter().chain(p.notes).collect();
     Ok((json(&q)?, notes))
 }
@@ -231,7 +251,8 @@ pub fn estimate(
         self::settings(&mut req, kind, given)?;
     }
     // settings and bounds are checked before the data, so a typo fails fast
-    req.resolved_bounds().map_err(|e| bad(e.to_string()))?;
+    req.check_settings().map_err(estimate_error)?;
+    req.resolved_bounds().map_err(estimate_error)?;
     let (op, mv): (Cow<'_, [f64]>, Cow<'_, [f64]>) = (slice(&op), slice(&mv));
     if op.len() != mv.len() {
         return Err(bad(format!(
@@ -254,6 +275,6 @@ pub fn estimate(
     }
     let est = py
         .detach(|| core_estimate::estimate(op, mv, &req))
-        .map_err(|e| bad(e.to_string()))?;
+        .map_err(estimate_error)?;
     Ok((json(&est)?, note.into_iter().collect()))
 }

@@ -2,14 +2,13 @@
 //! `stiction-report` crate): the record prepared and diagnosed as `diagnose` does, then rendered.
 //! The GIL is released while it runs.
 
-use crate::diagnose::{diagnose_error, prepare_error, Settings};
+use crate::diagnose::{run, Settings};
 use crate::{bad, slice, slice_bool};
 use numpy::PyReadonlyArray1;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use std::collections::HashMap;
-use stiction_core::diagnose as core;
-use stiction_core::record::{self, Signals};
+use stiction_core::record::Signals;
 use stiction_report::{ColumnNames, LoopData, PageOptions};
 
 /// The columns' names for the page's header: keys op, pv (both needed), sp, mode, time.
@@ -36,9 +35,7 @@ fn page(
     loop_id: &str,
     names: Option<&ColumnNames>,
 ) -> Result<String, PyErr> {
-    let p = record::prepare(signals, s.ts).map_err(|e| bad(prepare_error(e, s)))?;
-    let d = core::diagnose(&p.signals.record(), &s.request(p.ts))
-        .map_err(|e| bad(diagnose_error(e)))?;
+    let (d, p) = run(signals, s).map_err(bad)?;
     let v = &p.signals;
     let data = LoopData {
         op: &v.op,

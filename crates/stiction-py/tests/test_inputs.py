@@ -75,6 +75,13 @@ def test_errors_name_the_column_and_the_fix(loop):
         stiction.estimate(np.zeros(100), np.zeros(100), model="kano", method="exact")
     with pytest.raises(ValueError, match=r"unknown setting 'antz'"):
         stiction.estimate(np.zeros(100), np.zeros(100), antz=3)
+    # a search setting out of range names the keyword the user typed (ACO_R's q is locality=)
+    with pytest.raises(ValueError, match=r"^ants=0: ants must be at least 1$"):
+        stiction.estimate(np.zeros(100), np.zeros(100), method="aco", ants=0)
+    with pytest.raises(ValueError, match=r"^locality=0: locality must be "):
+        stiction.estimate(np.zeros(100), np.zeros(100), model="kano", method="aco-r", locality=0.0)
+    with pytest.raises(ValueError, match=r"^ants=0: ants must be at least 1$"):
+        stiction.quantify(loop, method="aco", ants=0)
     with pytest.raises(ValueError, match=r"model Stenman needs params d=VALUE|needs params d"):
         stiction.simulate("stenman")
     df = loop.copy()
