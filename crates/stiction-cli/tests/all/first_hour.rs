@@ -3,7 +3,7 @@
 //! R² with and without stiction, completions and a manual page, and wording without plurals
 //! such as "1 gaps" or times such as 0.20000000000004547.
 
-mod common;
+use crate::common;
 use common::{closed_stenman, fails, json, ok, stiction};
 use std::path::Path;
 

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::{closed_stenman, fails, json, ok};
 
 /// A closed loop (default process K = 3, tau = 10 s, delay = 10 s, PI 0.2 / 10 s).

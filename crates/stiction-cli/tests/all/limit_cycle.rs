@@ -1,7 +1,7 @@
 //! The loop family through the binary (issue 14): a fast loop written by `stiction simulate`,
 //! judged by `stiction diagnose` as a user would.
 
-mod common;
+use crate::common;
 use common::{json, ok};
 
 /// A fast loop sampled every 2 s (K = 1, τ = 12 s, dead time 30 s; PI 1.3 / 1500 s) with a

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
-mod common;
+use crate::common;
 use common::{closed_stenman, fails, stiction};
 
 fn s(p: &Path) -> &str {

@@ -3,11 +3,11 @@
 //! here. Timings (`seconds`) are left out; numbers compare to 1e-9 relative, words and keys exactly.
 //!
 //! After a deliberate change of an answer, rewrite the pins with
-//! `STICTION_BLESS=1 cargo test -p stiction-cli --test json_pin` and say why in the commit.
+//! `STICTION_BLESS=1 cargo test -p stiction-cli --test all json_pin` and say why in the commit.
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{json, ok};
 use serde_json::Value;
 

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{closed_stenman, fails, json, ok, stiction};
 
 fn tmp() -> tempfile::TempDir {

@@ -2,7 +2,7 @@
 //! many forms with zones and daylight saving, missing values, and files that are not tables.
 //! The same loop in every form must give the same answer.
 
-mod common;
+use crate::common;
 use common::{closed_stenman, fails, json, ok, stiction};
 use std::io::Write;
 use std::path::{Path, PathBuf};
