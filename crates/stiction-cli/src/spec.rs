@@ -2,7 +2,7 @@
 //! processes (`foptd:K=3,tau=10,delay=10`), model parameters.
 
 use anyhow::{bail, Context, Result};
-use stiction_core::estimate::{EstimateError, Method};
+use stiction_core::estimate::EstimateError;
 use stiction_core::models::{Model, ModelKind};
 use stiction_core::sim::{Pi, Process, Signal};
 use stiction_core::spec as core_spec;
@@ -107,10 +107,7 @@ pub fn setting_error(e: EstimateError) -> anyhow::Error {
             rule,
             value,
         } => {
-            let flag = match (method, name) {
-                (Method::AcoR, "q") => "locality".to_string(),
-                _ => name.replace('_', "-"),
-            };
+            let flag = method.setting_key(name).replace('_', "-");
             anyhow::anyhow!("--{flag} must be {rule}, got {value}")
         }
         e => e.into(),

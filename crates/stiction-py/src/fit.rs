@@ -22,10 +22,7 @@ fn estimate_error(e: EstimateError) -> PyErr {
             rule,
             value,
         } => {
-            let key = match (method, name) {
-                (Method::AcoR, "q") => "locality",
-                _ => name,
-            };
+            let key = method.setting_key(name);
             bad(format!("{key}={value}: {key} must be {rule}"))
         }
         e => bad(e.to_string()),

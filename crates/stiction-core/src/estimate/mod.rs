@@ -37,6 +37,16 @@ pub enum Method {
 }
 
 impl Method {
+    /// The name the front ends give one of this method's settings (the CLI's flag, Python's
+    /// keyword): the field's name, except ACO_R's `q`, which they call `locality` (ACO's `q` is its
+    /// pheromone deposit).
+    pub fn setting_key(self, name: &'static str) -> &'static str {
+        match (self, name) {
+            (Method::AcoR, "q") => "locality",
+            _ => name,
+        }
+    }
+
     /// Every method.
     pub const ALL: [Method; 4] = [Method::Aco, Method::AcoR, Method::Exact, Method::Grid];
 
