@@ -6,7 +6,7 @@ use crate::loop_file::Columns;
 use crate::loop_messages::{core_error, print_notes};
 use anyhow::Result;
 use std::path::PathBuf;
-use stiction_core::diagnose::diagnose;
+use stiction_core::diagnose::diagnose_checked;
 
 #[derive(clap::Args, Clone)]
 #[command(after_help = "Examples:
@@ -45,7 +45,8 @@ pub fn run(a: Args) -> Result<()> {
     req.window = a.window;
     req.quantify = !a.no_quantify;
     let name = table.path.display().to_string();
-    let d = diagnose(&lf.record(), &req).map_err(|e| core_error(&name, &lf, e))?;
+    let req = req.check().map_err(|e| core_error(&name, &lf, e))?;
+    let d = diagnose_checked(&lf.record(), &req).map_err(|e| core_error(&name, &lf, e))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&d)?);
         print_notes(&name, &lf, true);

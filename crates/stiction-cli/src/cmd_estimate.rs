@@ -108,9 +108,8 @@ pub fn run(a: Args) -> Result<()> {
     if a.trace.is_some() && !matches!(method, Method::Aco | Method::AcoR) {
         bail!("--trace: the {method} method has no iterations to trace; use --method aco or aco-r");
     }
-    // settings and bounds are checked before the file is read, so a typo fails fast
-    req.check_settings().map_err(spec::setting_error)?;
-    req.resolved_bounds().map_err(|e| anyhow::anyhow!("{e}"))?;
+    // the request is checked once, before the file is read, so a typo fails fast
+    let req = req.check().map_err(spec::setting_error)?;
 
     let table = a.reading.open(&a.file)?;
     let spec = a.reading.time_spec()?;
@@ -122,7 +121,7 @@ pub fn run(a: Args) -> Result<()> {
         estimate::MIN_SAMPLES,
     )?;
     let name = table.path.display().to_string();
-    let est = estimate::estimate(&pair.a, &pair.b, &req)
+    let est = estimate::estimate_checked(&pair.a, &pair.b, &req)
         .map_err(|e| anyhow::anyhow!("{name}: {}", spec::setting_error(e)))?;
     if let Some(path) = &a.trace {
         write_trace(path, kind, &est)?;

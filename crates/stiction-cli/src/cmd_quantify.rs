@@ -6,7 +6,7 @@ use anyhow::{bail, Result};
 use std::path::{Path, PathBuf};
 use stiction_core::estimate::IntervalKind;
 use stiction_core::quantify::{
-    quantify, FitOutput, LinearFamily, Quantification, QuantifyRequest, QuantifyStatus,
+    quantify_checked, FitOutput, LinearFamily, Quantification, QuantifyRequest, QuantifyStatus,
     ValveStartKind,
 };
 
@@ -141,7 +141,10 @@ pub fn run(a: Args) -> Result<()> {
         )?;
         req.bounds = Some(b);
     }
-    let q = quantify(&op, &pv, &req)
+    let req = req
+        .check()
+        .map_err(|e| anyhow::anyhow!("{name}: {}", spec::setting_error(e)))?;
+    let q = quantify_checked(&op, &pv, &req)
         .map_err(|e| anyhow::anyhow!("{name}: {}", spec::setting_error(e)))?;
     let notes: Vec<&String> = stretch.note.iter().chain(&lf.notes).collect();
 

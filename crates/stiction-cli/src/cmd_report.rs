@@ -8,7 +8,7 @@ use crate::loop_file::Columns;
 use crate::words::verdict;
 use anyhow::{Context, Result};
 use std::path::PathBuf;
-use stiction_core::diagnose::diagnose;
+use stiction_core::diagnose::diagnose_checked;
 use stiction_report::PageOptions;
 
 #[derive(clap::Args)]
@@ -42,8 +42,9 @@ pub fn run(a: Args) -> Result<()> {
     req.window = a.window;
     req.quantify = !a.no_quantify;
     let id = table.path.display().to_string();
-    let d =
-        diagnose(&lf.record(), &req).map_err(|e| crate::loop_messages::core_error(&id, &lf, e))?;
+    let core_error = |e| crate::loop_messages::core_error(&id, &lf, e);
+    let req = req.check().map_err(core_error)?;
+    let d = diagnose_checked(&lf.record(), &req).map_err(core_error)?;
     let names = a.columns.names();
     let options = PageOptions {
         columns: Some(&names),

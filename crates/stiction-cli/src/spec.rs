@@ -1,7 +1,7 @@
 //! Small text specs from the command line: `NAME=VALUE` lists, signals (`sine:amplitude=1,period=10`),
 //! processes (`foptd:K=3,tau=10,delay=10`), model parameters.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use stiction_core::estimate::EstimateError;
 use stiction_core::models::{Model, ModelKind};
 use stiction_core::sim::{Pi, Process, Signal};
@@ -88,19 +88,26 @@ impl FitArgs {
                 .map_err(|e| anyhow::anyhow!("--method: {e}"))?,
             None => stiction_core::Method::default_for(kind),
         };
-        if method == stiction_core::Method::Exact && kind != ModelKind::Stenman {
-            bail!(
-                "--method exact solves the Stenman model only; for {kind} use aco-r, aco or grid"
-            );
-        }
+        // the core's rule (exact is for Stenman only), before any file is read
+        stiction_core::Request::new(kind, method)
+            .check()
+            .map_err(setting_error)?;
         Ok((kind, method))
     }
 }
 
-/// A search setting out of range, in the words of the flag that sets it (`--ants must be at
-/// least 1, got 0`; ACO_R's `q` is `--locality`, ACO's `--q`); other estimate errors as they are.
+/// The core's request error in the words of the flag that sets the value: a search setting out
+/// of range (`--ants must be at least 1, got 0`; ACO_R's `q` is `--locality`, ACO's `--q`), the
+/// sampling time (`--ts`), the exact method for another model (`--method`); other errors as they
+/// are.
 pub fn setting_error(e: EstimateError) -> anyhow::Error {
     match e {
+        EstimateError::Ts(ts) => {
+            anyhow::anyhow!("--ts {ts}: the sampling time must be a positive number of seconds")
+        }
+        EstimateError::ExactNeedsStenman(kind) => anyhow::anyhow!(
+            "--method exact solves the Stenman model only; for {kind} use aco-r, aco or grid"
+        ),
         EstimateError::Setting {
             method,
             name,

@@ -34,6 +34,7 @@
 
 #![warn(missing_docs)]
 
+pub mod checked;
 pub mod detect;
 pub mod diagnose;
 pub mod estimate;
@@ -51,5 +52,6 @@ pub mod sim_check;
 pub mod spec;
 pub mod spectral;
 
-pub use estimate::{estimate, Estimate, Method, Request};
+pub use checked::Checked;
+pub use estimate::{estimate, estimate_checked, Estimate, Method, Request};
 pub use models::{Model, ModelKind, StictionModel};

@@ -70,7 +70,8 @@ fn diagnose_error(e: DiagnoseError) -> String {
 /// order, sampling time and notes), or one sentence.
 pub fn run<'a>(signals: Signals<'a>, s: &Settings) -> Result<(Diagnosis, Prepared<'a>), String> {
     let p = record::prepare(signals, s.ts).map_err(|e| prepare_error(e, s))?;
-    let d = core::diagnose(&p.signals.record(), &s.request(p.ts)).map_err(diagnose_error)?;
+    let req = s.request(p.ts).check().map_err(diagnose_error)?;
+    let d = core::diagnose_checked(&p.signals.record(), &req).map_err(diagnose_error)?;
     Ok((d, p))
 }
 

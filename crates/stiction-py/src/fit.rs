@@ -12,10 +12,17 @@ use stiction_core::models::ModelKind;
 use stiction_core::quantify::{self as core_quantify, QuantifyRequest};
 use stiction_core::record::{self, longest_clean, PrepareError, Signals};
 
-/// The core's error in one sentence; a method's setting out of range is named by its keyword
-/// (ACO_R's `q` is `locality=`), as the CLI names its flag.
+/// The core's error in one sentence naming the keyword argument, as the CLI names its flag: a
+/// method's setting out of range (ACO_R's `q` is `locality=`), the sampling time, the exact
+/// method for another model.
 fn estimate_error(e: EstimateError) -> PyErr {
     match e {
+        EstimateError::Ts(ts) => bad(format!(
+            "ts={ts}: the sampling time must be a positive number of seconds"
+        )),
+        EstimateError::ExactNeedsStenman(kind) => bad(format!(
+            "method='exact' solves the Stenman model only; for {kind} use aco-r, aco or grid"
+        )),
         EstimateError::Setting {
             method,
             name,
@@ -40,11 +47,8 @@ fn model_method(model: &str, method: Option<&str>) -> PyResult<(ModelKind, Metho
             .map_err(|e| bad(format!("method='{m}': {e}")))?,
         None => Method::default_for(kind),
     };
-    if method == Method::Exact && kind != ModelKind::Stenman {
-        return Err(bad(format!(
-            "method='exact' solves the Stenman model only; for {kind} use aco-r, aco or grid"
-        )));
-    }
+    // the core's rule (exact is for Stenman only), before the data are looked at
+    Request::new(kind, method).check().map_err(estimate_error)?;
     Ok((kind, method))
 }
 
@@ -180,8 +184,9 @@ pub fn quantify(
         let range = (0.0, (hi - lo).max(f64::MIN_POSITIVE));
         req.bounds = Some(self::bounds(kind, given, vec![range; kind.dim()])?);
     }
+    let req = req.check().map_err(estimate_error)?;
     let q = py
-        .detach(|| core_quantify::quantify(op, pv, &req))
+        .detach(|| core_quantify::quantify_checked(op, pv, &req))
         .map_err(estimate_error)?;
     let notes = note.into_iter().chain(p.notes).collect();
     Ok((json(&q)?, notes))
@@ -247,9 +252,8 @@ pub fn estimate(
     if let Some(given) = &settings {
         self::settings(&mut req, kind, given)?;
     }
-    // settings and bounds are checked before the data, so a typo fails fast
-    req.check_settings().map_err(estimate_error)?;
-    req.resolved_bounds().map_err(estimate_error)?;
+    // the request is checked once, before the data, so a typo fails fast
+    let req = req.check().map_err(estimate_error)?;
     let (op, mv): (Cow<'_, [f64]>, Cow<'_, [f64]>) = (slice(&op), slice(&mv));
     if op.len() != mv.len() {
         return Err(bad(format!(
@@ -271,7 +275,7 @@ pub fn estimate(
         )));
     }
     let est = py
-        .detach(|| core_estimate::estimate(op, mv, &req))
+        .detach(|| core_estimate::estimate_checked(op, mv, &req))
         .map_err(estimate_error)?;
     Ok((json(&est)?, note.into_iter().collect()))
 }

@@ -29,6 +29,7 @@ pub use result::{Band, BandSource, Diagnosis, Index, Oscillation, Verdict, Vote,
 /// `auto`: `true` where the controller is in automatic). Missing values are NaN.
 pub use crate::quality::Record as LoopRecord;
 
+pub use crate::checked::Checked;
 use crate::quality::{self, Finding, Gate};
 use crate::quantify::{compare_fits, CompareRequest};
 use evidence::Context;
@@ -98,8 +99,8 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
     }
 }
 
-/// Diagnose one loop: gate the record, judge its usable stretches with the families of evidence
-/// and, on a stiction verdict, size the band.
+/// Check the request and diagnose one loop: [`DiagnoseRequest::check`], then
+/// [`diagnose_checked`].
 ///
 /// A healthy valve in the same loop as the crate root's example:
 ///
@@ -120,8 +121,18 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn diagnose(r: &LoopRecord, req: &DiagnoseRequest) -> Result<Diagnosis, DiagnoseError> {
+    diagnose_checked(r, &req.check()?)
+}
+
+/// Diagnose one loop with a checked request: gate the record, judge its usable stretches with
+/// the families of evidence and, on a stiction verdict, size the band. The signals must all be
+/// as long as OP (the one error the data can give).
+pub fn diagnose_checked(
+    r: &LoopRecord,
+    req: &Checked<DiagnoseRequest>,
+) -> Result<Diagnosis, DiagnoseError> {
     let started = Instant::now();
-    request::check(r, req)?;
+    request::check_record(r)?;
     let n = r.op.len();
     let (stretches, excluded) = stretch::usable(r, req);
     let (s, e) = stretches

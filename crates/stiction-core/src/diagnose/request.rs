@@ -1,5 +1,6 @@
 //! What `diagnose` is asked, and the request's errors.
 
+use crate::checked::Checked;
 use crate::quality::{Limits, Record};
 use serde::{Deserialize, Serialize};
 
@@ -56,6 +57,80 @@ impl Default for DiagnoseRequest {
 }
 
 impl DiagnoseRequest {
+    /// Check the request once, before any data are read: the sampling time, the window, the OP
+    /// range and the judgement's settings (the first one wrong is the error).
+    /// [`super::diagnose_checked`] runs the checked request without checking it again.
+    pub fn check(&self) -> Result<Checked<DiagnoseRequest>, DiagnoseError> {
+        if !(self.ts > 0.0 && self.ts.is_finite()) {
+            return Err(DiagnoseError::Ts(self.ts));
+        }
+        if let Some(w) = self.window {
+            if w < self.min_samples {
+                return Err(DiagnoseError::Window {
+                    window: w,
+                    least: self.min_samples,
+                });
+            }
+        }
+        let [lo, hi] = self.op_range;
+        if !(hi > lo && lo.is_finite() && hi.is_finite()) {
+            return Err(DiagnoseError::OpRange { lo, hi });
+        }
+        self.check_settings()?;
+        Ok(Checked::new(self.clone()))
+    }
+
+    /// The judgement's settings and the gates' limits, each in its range.
+    fn check_settings(&self) -> Result<(), DiagnoseError> {
+        let check = |ok: bool, name: &'static str, rule: &'static str, value: f64| {
+            if ok {
+                Ok(())
+            } else {
+                Err(DiagnoseError::Setting { name, rule, value })
+            }
+        };
+        let share = |x: f64| (0.0..=1.0).contains(&x);
+        let l = &self.limits;
+        check(
+            self.min_periods > 0.0 && self.min_periods.is_finite(),
+            "min_periods",
+            "a finite number > 0",
+            self.min_periods,
+        )?;
+        check(
+            self.min_samples >= 2,
+            "min_samples",
+            "at least 2",
+            self.min_samples as f64,
+        )?;
+        check(
+            share(self.verdict_margin),
+            "verdict_margin",
+            "between 0 and 1",
+            self.verdict_margin,
+        )?;
+        let shares = [
+            ("limits.saturated_share", l.saturated_share),
+            ("limits.repeated_share", l.repeated_share),
+            ("limits.manual_share", l.manual_share),
+        ];
+        for (name, value) in shares {
+            check(share(value), name, "a share between 0 and 1", value)?;
+        }
+        check(
+            l.levels_per_100 >= 0.0 && l.levels_per_100.is_finite(),
+            "limits.levels_per_100",
+            "a finite number >= 0",
+            l.levels_per_100,
+        )?;
+        check(
+            l.gap_steps > 0.0 && l.gap_steps.is_finite(),
+            "limits.gap_steps",
+            "a finite number > 0",
+            l.gap_steps,
+        )
+    }
+
     /// A band in OP units as a percentage of the valve's span.
     pub fn percent_of_span(&self, op_units: f64) -> f64 {
         100.0 * op_units / (self.op_range[1] - self.op_range[0])
@@ -103,9 +178,20 @@ pub enum DiagnoseError {
         /// OP of a fully open valve.
         hi: f64,
     },
+    /// A setting of the judgement or a gate's limit out of range, named as its field.
+    #[error("{name} must be {rule}, got {value}")]
+    Setting {
+        /// The field (`min_periods`, `limits.gap_steps`, ...).
+        name: &'static str,
+        /// What it must be.
+        rule: &'static str,
+        /// The value given.
+        value: f64,
+    },
 }
 
-pub(super) fn check(r: &Record, req: &DiagnoseRequest) -> Result<(), DiagnoseError> {
+/// The record's signals all as long as OP (the data's check; the request is checked when built).
+pub(super) fn check_record(r: &Record) -> Result<(), DiagnoseError> {
     if r.op.len() != r.pv.len() {
         return Err(DiagnoseError::Lengths {
             op: r.op.len(),
@@ -125,20 +211,84 @@ pub(super) fn check(r: &Record, req: &DiagnoseRequest) -> Result<(), DiagnoseErr
             }
         }
     }
-    if !(req.ts > 0.0 && req.ts.is_finite()) {
-        return Err(DiagnoseError::Ts(req.ts));
-    }
-    if let Some(w) = req.window {
-        if w < req.min_samples {
-            return Err(DiagnoseError::Window {
-                window: w,
-                least: req.min_samples,
-            });
-        }
-    }
-    let [lo, hi] = req.op_range;
-    if !(hi > lo && lo.is_finite() && hi.is_finite()) {
-        return Err(DiagnoseError::OpRange { lo, hi });
-    }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn check_finds_each_kind_of_mistake() {
+        let good = DiagnoseRequest::default();
+        assert_eq!(*good.check().unwrap(), good);
+        let with = |change: fn(&mut DiagnoseRequest)| {
+            let mut r = DiagnoseRequest::default();
+            change(&mut r);
+            r.check().unwrap_err()
+        };
+        assert_eq!(
+            with(|r| r.ts = f64::NAN).to_string(),
+            "the sampling time must be a positive number of seconds, got NaN"
+        );
+        assert_eq!(
+            with(|r| r.window = Some(50)),
+            DiagnoseError::Window {
+                window: 50,
+                least: 200
+            }
+        );
+        assert_eq!(
+            with(|r| r.op_range = [100.0, 0.0]),
+            DiagnoseError::OpRange { lo: 100.0, hi: 0.0 }
+        );
+        assert!(matches!(
+            with(|r| r.min_periods = 0.0),
+            DiagnoseError::Setting {
+                name: "min_periods",
+                ..
+            }
+        ));
+        assert!(matches!(
+            with(|r| r.verdict_margin = 1.5),
+            DiagnoseError::Setting {
+                name: "verdict_margin",
+                ..
+            }
+        ));
+        assert_eq!(
+            with(|r| r.limits.manual_share = 2.0).to_string(),
+            "limits.manual_share must be a share between 0 and 1, got 2"
+        );
+    }
+
+    #[test]
+    fn check_record_needs_every_signal_as_long_as_op() {
+        let (op, pv, sp) = ([0.0; 4], [0.0; 4], [0.0; 3]);
+        let r = Record {
+            op: &op,
+            pv: &pv,
+            sp: Some(&sp),
+            mv: None,
+            time: None,
+            auto: None,
+        };
+        assert_eq!(
+            check_record(&r),
+            Err(DiagnoseError::OtherLength {
+                signal: "sp",
+                len: 3,
+                op: 4
+            })
+        );
+        let r = Record {
+            sp: None,
+            pv: &pv[..2],
+            ..r
+        };
+        assert_eq!(
+            check_record(&r),
+            Err(DiagnoseError::Lengths { op: 4, pv: 2 })
+        );
+    }
 }

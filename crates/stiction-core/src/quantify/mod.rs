@@ -29,6 +29,7 @@ mod result;
 mod search;
 mod start;
 
+pub use crate::checked::Checked;
 pub use compare::{compare_fits, CompareRequest, FitComparison, ModelFit};
 pub use request::QuantifyRequest;
 pub use result::{
@@ -48,18 +49,9 @@ const STAGE_PERIODS: f64 = 8.0;
 /// ... when the record has at least this many samples.
 const STAGE_FROM: usize = 1500;
 
-/// The search's settings as an estimate request, to check them as `estimate` does (an ant count
-/// of 0 is an error naming the setting, not a failed search).
-fn settings_request(req: &QuantifyRequest) -> crate::estimate::Request {
-    let mut r = crate::estimate::Request::new(req.model, req.method);
-    r.aco = req.aco.clone();
-    r.acor = req.acor.clone();
-    r.grid = req.grid.clone();
-    r
-}
-
-/// Quantify stiction from OP and PV. Data that cannot be judged gives `status: insufficient_data`
-/// with the reason; requests that are wrong (bounds, settings) give an error.
+/// Check the request and quantify stiction from OP and PV: [`QuantifyRequest::check`], then
+/// [`quantify_checked`]. Data that cannot be judged gives `status: insufficient_data` with the
+/// reason; requests that are wrong (bounds, settings) give an error.
 ///
 /// A closed loop with a sticky valve, its band estimated from OP and PV alone:
 ///
@@ -82,8 +74,17 @@ pub fn quantify(
     pv: &[f64],
     req: &QuantifyRequest,
 ) -> Result<Quantification, EstimateError> {
+    quantify_checked(op, pv, &req.check()?)
+}
+
+/// Quantify stiction from OP and PV with a checked request (long Stenman records are staged:
+/// the whole d-range on the first samples, then its best cells on the whole record).
+pub fn quantify_checked(
+    op: &[f64],
+    pv: &[f64],
+    req: &Checked<QuantifyRequest>,
+) -> Result<Quantification, EstimateError> {
     let started = Instant::now();
-    settings_request(req).check_settings()?;
     let n = op.len();
     if !(req.model == ModelKind::Stenman && req.method == Method::Exact && pv.len() == n) {
         return quantify_inner(op, pv, req, None).map(|r| r.0);
@@ -110,11 +111,11 @@ pub fn quantify(
         let (best, evaluations) = start::best_start(&op[..m], &pv[..m], &req);
         extra += evaluations;
         if best.is_some_and(|x0| x0 != op[0]) {
-            let mut plain = req.clone();
-            plain.estimate_start = false;
-            at_first_op = Some(quantify(op, pv, &plain)?);
+            let plain = req.adjust(|r| r.estimate_start = false);
+            at_first_op = Some(quantify_checked(op, pv, &plain)?);
         }
-        req.valve_start = best;
+        // a candidate position is a finite OP value: the request stays valid
+        req = req.adjust(|r| r.valve_start = best);
     }
     let finish = |mut q: Quantification, extra: u64| {
         q.evaluations += extra;
@@ -128,9 +129,10 @@ pub fn quantify(
     if staged {
         // stage 1: the whole d-range on the first samples (same valve start, so every
         // whole-record cell lies inside one of its cells)
-        let mut first = req.clone();
-        first.staged = false;
-        first.full_partition = true;
+        let first = req.adjust(|r| {
+            r.staged = false;
+            r.full_partition = true;
+        });
         if let Ok((q, hint)) = quantify_inner(&op[..m], &pv[..m], &first, None) {
             if q.status == QuantifyStatus::Ok && !hint.ranges.is_empty() {
                 let (full, _) = quantify_inner(op, pv, &req, Some(&hint))?;

@@ -1,6 +1,7 @@
 //! What `quantify` is asked to do.
 
-use crate::estimate::{AcoSettings, AcorSettings, GridSettings, Method};
+use crate::checked::Checked;
+use crate::estimate::{self, AcoSettings, AcorSettings, EstimateError, GridSettings, Method};
 use crate::models::ModelKind;
 use serde::{Deserialize, Serialize};
 
@@ -71,5 +72,63 @@ impl QuantifyRequest {
             valve_start: None,
             estimate_start: false,
         }
+    }
+
+    /// Check the request once, before any data are read: the sampling time, the search method's
+    /// settings (as [`estimate::Request::check`] does: an ant count of 0 is an error naming the
+    /// setting, not a failed search), the exact method asked for Stenman only, the search range
+    /// when one is given, and the valve's start position. [`super::quantify_checked`] runs the
+    /// checked request without checking it again.
+    pub fn check(&self) -> Result<Checked<QuantifyRequest>, EstimateError> {
+        if !(self.ts > 0.0 && self.ts.is_finite()) {
+            return Err(EstimateError::Ts(self.ts));
+        }
+        let mut settings = estimate::Request::new(self.model, self.method);
+        settings.aco = self.aco.clone();
+        settings.acor = self.acor.clone();
+        settings.grid = self.grid.clone();
+        settings.check_settings()?;
+        if let Some(bounds) = &self.bounds {
+            estimate::check_bounds(self.model, bounds)?;
+        }
+        if let Some(x0) = self.valve_start.filter(|x| !x.is_finite()) {
+            return Err(EstimateError::ValveStart(x0));
+        }
+        Ok(Checked::new(self.clone()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn check_finds_each_kind_of_mistake() {
+        let good = QuantifyRequest::new(ModelKind::Stenman, Method::Exact);
+        assert_eq!(*good.check().unwrap(), good);
+        let mut r = good.clone();
+        r.ts = 0.0;
+        assert_eq!(r.check().unwrap_err(), EstimateError::Ts(0.0));
+        let mut r = good.clone();
+        r.bounds = Some(vec![(-1.0, 1.0)]);
+        assert!(matches!(r.check(), Err(EstimateError::Bounds { .. })));
+        let mut r = good.clone();
+        r.valve_start = Some(f64::INFINITY);
+        assert!(matches!(r.check(), Err(EstimateError::ValveStart(x)) if x.is_infinite()));
+        let mut r = QuantifyRequest::new(ModelKind::He, Method::AcoR);
+        r.acor.archive = 1;
+        assert!(matches!(
+            r.check(),
+            Err(EstimateError::Setting {
+                method: Method::AcoR,
+                name: "archive",
+                ..
+            })
+        ));
+        let r = QuantifyRequest::new(ModelKind::He, Method::Exact);
+        assert_eq!(
+            r.check().unwrap_err(),
+            EstimateError::ExactNeedsStenman(ModelKind::He)
+        );
     }
 }

@@ -11,6 +11,7 @@ use super::{
     quantify, FitOutput, FitQuality, LinearFamily, LinearModel, Quantification, QuantifyRequest,
     QuantifyStatus, ValveStartKind,
 };
+use crate::checked::Checked;
 use crate::estimate::solver::{self, Evaluator};
 use crate::estimate::{self, aco, acor, EstimateError, IntervalKind, Method};
 use crate::identify::{self, Data, Fit, SearchRange, Structure};
@@ -64,7 +65,7 @@ struct Work {
 pub(super) fn quantify_inner(
     op: &[f64],
     pv: &[f64],
-    req: &QuantifyRequest,
+    req: &Checked<QuantifyRequest>,
     hint: Option<&Hint>,
 ) -> Result<(Quantification, Hint), EstimateError> {
     let started = Instant::now();
@@ -111,15 +112,6 @@ fn gates<'a>(
 ) -> Result<Result<Setup<'a>, (f64, String)>, EstimateError> {
     let n = op.len();
     estimate::check_pair(("op", op), ("pv", pv))?;
-    if !(req.ts > 0.0 && req.ts.is_finite()) {
-        return Err(EstimateError::Settings(format!(
-            "the sampling time must be a positive number of seconds, got {}",
-            req.ts
-        )));
-    }
-    if req.method == Method::Exact && req.model != ModelKind::Stenman {
-        return Err(EstimateError::ExactNeedsStenman(req.model));
-    }
     let (op_lo, op_hi) = range(op);
     let (pv_lo, pv_hi) = range(pv);
     let op_range = if n > 0 { op_hi - op_lo } else { 0.0 };
@@ -150,11 +142,15 @@ fn gates<'a>(
     if let Some(why) = why {
         return Ok(Err((op_range, why)));
     }
+    // bounds given were checked with the request; the default range comes from the data
     let bounds: Vec<(f64, f64)> = match &req.bounds {
         Some(b) => b.clone(),
-        None => vec![(0.0, op_range); req.model.dim()],
+        None => {
+            let range = vec![(0.0, op_range); req.model.dim()];
+            estimate::check_bounds(req.model, &range)?;
+            range
+        }
     };
-    estimate::check_bounds(req.model, &bounds)?;
     Ok(Ok(Setup {
         op_range,
         search: search.clone(),

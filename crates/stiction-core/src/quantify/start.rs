@@ -2,20 +2,27 @@
 
 use super::search::quantify_inner;
 use super::{problem::range, QuantifyRequest, QuantifyStatus};
+use crate::checked::Checked;
 
 /// A record rarely starts just as the valve moved, and a Stenman valve started elsewhere can stay
 /// out of step with the real one for good. Each candidate position at the first sample (the first
 /// OP and a spread across the span OP covers) gets a search of `op`, `pv` (the exact search
 /// around its best grid points); the one that fits best is returned, with the evaluations spent.
-pub(super) fn best_start(op: &[f64], pv: &[f64], req: &QuantifyRequest) -> (Option<f64>, u64) {
-    let mut local = req.clone();
-    local.staged = false;
-    local.full_partition = false;
+pub(super) fn best_start(
+    op: &[f64],
+    pv: &[f64],
+    req: &Checked<QuantifyRequest>,
+) -> (Option<f64>, u64) {
+    let local = req.adjust(|r| {
+        r.staged = false;
+        r.full_partition = false;
+    });
     let mut evaluations = 0;
     let mut best: Option<(f64, f64)> = None;
     for x0 in start_candidates(op) {
-        local.valve_start = Some(x0);
-        let Ok((q, _)) = quantify_inner(op, pv, &local, None) else {
+        // a candidate is a finite OP value: the request stays valid
+        let at = local.adjust(|r| r.valve_start = Some(x0));
+        let Ok((q, _)) = quantify_inner(op, pv, &at, None) else {
             continue;
         };
         evaluations += q.evaluations;
