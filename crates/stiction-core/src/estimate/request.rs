@@ -206,7 +206,7 @@ impl Request {
 
     /// Check the request once, before any data are read: the chosen method's settings (the first
     /// one out of range is the error), the exact method asked for Stenman only, and the search
-    /// range. [`estimate_checked`] runs the checked request without checking it again.
+    /// range. [`super::estimate_checked`] runs the checked request without checking it again.
     pub fn check(&self) -> Result<Checked<Request>, EstimateError> {
         self.check_settings()?;
         check_bounds(self.model, &self.search_range())?;
