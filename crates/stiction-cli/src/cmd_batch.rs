@@ -83,6 +83,9 @@ whose input or settings changed, and keeps, marked 'vanished', a loop whose inpu
 Exit status: 0 every loop diagnosed, 3 finished with failed loops, 2 unusable arguments or files
 that cannot be written, 130 / 143 stopped by a signal."
 )]
+// the fields' doc comments are the --help text, written for a terminal ([[loop]], <id>), not
+// rustdoc
+#[allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 pub struct Args {
     /// Folders (every *.csv directly inside), file patterns such as 'plant/*.csv' (quoted), CSV
     /// files with one loop each, or long-format CSV files with a loop id column (many loops, the

@@ -8,8 +8,8 @@
 //! elsewhere (the fleet page carries a few lines of inline script to sort and filter). Every text
 //! taken from the data (file, column and loop names) is escaped by the templates.
 //!
-//! The context of a page is built first as plain serialisable structs ([`context`], [`sections`],
-//! [`fleet`]); the templates only lay it out.
+//! The context of a page is built first as plain serialisable structs (the private `context`
+//! and `sections`, and [`fleet`]); the templates only lay it out.
 
 pub mod chart;
 mod context;

@@ -19,7 +19,7 @@ use zone::{check_repeats, local_seconds, DstCount};
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub enum TimeFormat {
     /// Numbers are seconds (epoch milliseconds when every value is past 1e11); text is tried
-    /// against the forms in [`PATTERNS`] and ISO 8601.
+    /// against the forms in [`forms::PATTERNS`] and ISO 8601.
     #[default]
     Auto,
     /// Numbers of seconds (since 1970 or since any start).
