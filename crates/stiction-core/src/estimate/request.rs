@@ -238,16 +238,15 @@ impl Request {
         };
         const AT_LEAST_1: &str = "at least 1";
         const POSITIVE: &str = "a finite number > 0";
+        // the ant methods' population: at least one ant and one iteration
+        let population = |ants: usize, iterations: usize| {
+            check(ants >= 1, "ants", AT_LEAST_1, ants as f64)?;
+            check(iterations >= 1, "iterations", AT_LEAST_1, iterations as f64)
+        };
         match method {
             Method::Aco => {
                 let s = &self.aco;
-                check(s.ants >= 1, "ants", AT_LEAST_1, s.ants as f64)?;
-                check(
-                    s.iterations >= 1,
-                    "iterations",
-                    AT_LEAST_1,
-                    s.iterations as f64,
-                )?;
+                population(s.ants, s.iterations)?;
                 check(
                     positive(s.rho) && s.rho < 1.0,
                     "rho",
@@ -267,13 +266,7 @@ impl Request {
             }
             Method::AcoR => {
                 let s = &self.acor;
-                check(s.ants >= 1, "ants", AT_LEAST_1, s.ants as f64)?;
-                check(
-                    s.iterations >= 1,
-                    "iterations",
-                    AT_LEAST_1,
-                    s.iterations as f64,
-                )?;
+                population(s.ants, s.iterations)?;
                 check(s.archive >= 2, "archive", "at least 2", s.archive as f64)?;
                 check(positive(s.q), "q", POSITIVE, s.q)?;
                 check(positive(s.xi), "xi", POSITIVE, s.xi)?;
