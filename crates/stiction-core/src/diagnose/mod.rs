@@ -29,7 +29,7 @@ pub use result::{Band, BandSource, Diagnosis, Index, Oscillation, Verdict, Vote,
 /// `auto`: `true` where the controller is in automatic). Missing values are NaN.
 pub use crate::quality::Record as LoopRecord;
 
-pub use crate::checked::Checked;
+use crate::checked::Checked;
 use crate::quality::{self, Finding, Gate};
 use crate::quantify::{compare_fits, CompareRequest};
 use evidence::Context;

@@ -11,7 +11,7 @@ mod request;
 mod result;
 pub mod solver;
 
-pub use crate::checked::Checked;
+use crate::checked::Checked;
 use crate::models::ModelKind;
 use crate::rng::seeded;
 use std::collections::BTreeMap;

@@ -29,7 +29,7 @@ mod result;
 mod search;
 mod start;
 
-pub use crate::checked::Checked;
+use crate::checked::Checked;
 pub use compare::{compare_fits, CompareRequest, FitComparison, ModelFit};
 pub use request::QuantifyRequest;
 pub use result::{
