@@ -16,9 +16,12 @@
 //! true valve position does not explain PV better than OP, no fit from OP and PV can tell the
 //! valve is sticky.
 
+#[path = "common/catalogue_loop.rs"]
+mod catalogue_loop;
+
 use rayon::prelude::*;
 use std::fmt::Write as _;
-use stiction_core::diagnose::{diagnose, DiagnoseRequest, Family, LoopRecord};
+use stiction_core::diagnose::{diagnose, DiagnoseRequest, Family};
 use stiction_core::identify::{self, Data, Fit, SearchRange, Structure};
 use stiction_core::sim::catalogue::{catalogue, BenchmarkLoop, Set, Suite, Truth};
 
@@ -57,20 +60,10 @@ fn best_fit(data: &Data, input: &[f64], range: &SearchRange) -> f64 {
 /// (truth, the family's test ratio, the ceiling's test ratio).
 fn ratios(l: &BenchmarkLoop) -> Option<(Truth, f64, f64)> {
     let d = &l.data;
-    let ts = d.t[1] - d.t[0];
-    let rec = LoopRecord {
-        op: &d.op,
-        pv: &d.pv,
-        sp: Some(&d.sp),
-        mv: None,
-        time: Some(&d.t),
-        auto: None,
-    };
+    let rec = catalogue_loop::record(l);
     let req = DiagnoseRequest {
-        ts,
-        integrating: l.integrating,
         quantify: false,
-        ..DiagnoseRequest::default()
+        ..catalogue_loop::request(l)
     };
     let dg = diagnose(&rec, &req).ok()?;
     let m = dg

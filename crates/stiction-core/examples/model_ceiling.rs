@@ -16,9 +16,12 @@
 //! feeds back into OP at once) cannot favour OP. The calibration set by default (`--benchmark`:
 //! the benchmark seeds).
 
+#[path = "common/catalogue_loop.rs"]
+mod catalogue_loop;
+
 use rayon::prelude::*;
 use std::fmt::Write as _;
-use stiction_core::diagnose::{diagnose, DiagnoseRequest, LoopRecord, Vote};
+use stiction_core::diagnose::{diagnose, Vote};
 use stiction_core::quantify::{compare_fits, CompareRequest};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, Set, Suite, Truth};
 
@@ -138,19 +141,7 @@ fn judge(l: &BenchmarkLoop) -> Row {
     };
     let fitted =
         compare_fits(&d.op, &d.pv, &req).map(|f| llr(&d.pv, &d.op, &f.mv_stiction, l.integrating));
-    let record = LoopRecord {
-        op: &d.op,
-        pv: &d.pv,
-        sp: Some(&d.sp),
-        mv: None,
-        time: Some(&d.t),
-        auto: None,
-    };
-    let dreq = DiagnoseRequest {
-        ts: l.ts(),
-        integrating: l.integrating,
-        ..DiagnoseRequest::default()
-    };
+    let (record, dreq) = (catalogue_loop::record(l), catalogue_loop::request(l));
     let model_vote = diagnose(&record, &dreq).ok().and_then(|g| {
         g.families
             .iter()

@@ -23,13 +23,16 @@
 //! The backlash-only valve is reported outside the goals. (Issue 14, fast): at least 95 % of the
 //! sticky loops called `stiction`; every look-alike class at least 95 % not called `stiction`.
 
+#[path = "common/catalogue_loop.rs"]
+mod catalogue_loop;
+
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::process::exit;
 use std::time::Instant;
-use stiction_core::diagnose::{diagnose, DiagnoseRequest, Diagnosis, LoopRecord, Verdict, Vote};
+use stiction_core::diagnose::{diagnose, Diagnosis, Verdict, Vote};
 use stiction_core::sim::catalogue::{
     self, BenchmarkLoop, LoopClass, NoiseLevel, Set, Suite, Truth,
 };
@@ -116,20 +119,7 @@ fn options() -> Options {
 
 /// A loop's diagnosis, judged as the CLI judges a file with t, sp, op, pv columns.
 fn judge(l: &BenchmarkLoop) -> (Diagnosis, f64) {
-    let d = &l.data;
-    let rec = LoopRecord {
-        op: &d.op,
-        pv: &d.pv,
-        sp: Some(&d.sp),
-        mv: None,
-        time: Some(&d.t),
-        auto: None,
-    };
-    let req = DiagnoseRequest {
-        ts: l.ts(),
-        integrating: l.integrating,
-        ..DiagnoseRequest::default()
-    };
+    let (rec, req) = (catalogue_loop::record(l), catalogue_loop::request(l));
     let t = Instant::now();
     let dg = diagnose(&rec, &req).expect("catalogue records are valid requests");
     (dg, t.elapsed().as_secs_f64())
