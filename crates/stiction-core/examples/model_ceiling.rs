@@ -117,8 +117,8 @@ fn sse(y: &[f64], cols: &[Vec<f64>]) -> f64 {
         .sum()
 }
 
-fn llr(pv: &[f64], op: &[f64], valve: &[f64], integrating: bool) -> f64 {
-    let with_op = sse(pv, &regressors(op, integrating));
+/// The ratio for `valve`, against OP's residual sum of squares `with_op`.
+fn llr(pv: &[f64], with_op: f64, valve: &[f64], integrating: bool) -> f64 {
     let with_valve = sse(pv, &regressors(valve, integrating));
     pv.len() as f64 / 2.0 * (with_op / with_valve.max(f64::MIN_POSITIVE)).ln()
 }
@@ -133,14 +133,15 @@ struct Row {
 
 fn judge(l: &BenchmarkLoop) -> Row {
     let d = &l.data;
-    let oracle = llr(&d.pv, &d.op, &d.mv, l.integrating);
+    let with_op = sse(&d.pv, &regressors(&d.op, l.integrating));
+    let oracle = llr(&d.pv, with_op, &d.mv, l.integrating);
     let req = CompareRequest {
         ts: l.ts(),
         integrating: Some(l.integrating),
         ..CompareRequest::default()
     };
-    let fitted =
-        compare_fits(&d.op, &d.pv, &req).map(|f| llr(&d.pv, &d.op, &f.mv_stiction, l.integrating));
+    let fitted = compare_fits(&d.op, &d.pv, &req)
+        .map(|f| llr(&d.pv, with_op, &f.mv_stiction, l.integrating));
     let (record, dreq) = (catalogue_loop::record(l), catalogue_loop::request(l));
     let model_vote = diagnose(&record, &dreq).ok().and_then(|g| {
         g.families
