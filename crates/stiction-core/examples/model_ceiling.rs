@@ -18,6 +18,10 @@
 
 #[path = "common/catalogue_loop.rs"]
 mod catalogue_loop;
+#[path = "common/clean_fit.rs"]
+mod clean_fit;
+
+use clean_fit::{Bank, CleanFit};
 
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -27,101 +31,11 @@ use stiction_core::sim::catalogue::{self, BenchmarkLoop, Set, Suite, Truth};
 
 /// The log-likelihood ratio a loop must reach to count as "the data show the valve".
 const SHOWS: f64 = 20.0;
-/// Samples between the drift's knots.
-const KNOT_EVERY: usize = 150;
-
-/// Columns of the regression, each `n` long.
-fn regressors(valve: &[f64], integrating: bool) -> Vec<Vec<f64>> {
-    let n = valve.len();
-    let mean = valve.iter().sum::<f64>() / n as f64;
-    let u: Vec<f64> = valve.iter().map(|v| v - mean).collect();
-    let mut cols = Vec::new();
-    for tau in [0.3, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0] {
-        let a = (-1.0f64 / tau).exp();
-        let mut s = u[0];
-        let mut c = vec![0.0; n];
-        for t in 1..n {
-            c[t] = s;
-            s = a * s + (1.0 - a) * u[t];
-        }
-        cols.push(c);
-    }
-    for d in [2, 3, 5, 8] {
-        cols.push(
-            (0..n)
-                .map(|t| if t >= d { u[t - d] } else { 0.0 })
-                .collect(),
-        );
-    }
-    if integrating {
-        let mut s = 0.0;
-        cols.push(
-            (0..n)
-                .map(|t| {
-                    let c = s;
-                    s += u[t];
-                    c
-                })
-                .collect(),
-        );
-    }
-    let knots = (n / KNOT_EVERY).max(2);
-    cols.push(vec![1.0; n]);
-    for k in 0..knots {
-        let at = k * n / knots;
-        cols.push((0..n).map(|t| t.saturating_sub(at) as f64).collect());
-    }
-    cols
-}
-
-/// Residual sum of squares of `y` regressed on `cols` (normal equations, Cholesky, a small ridge).
-fn sse(y: &[f64], cols: &[Vec<f64>]) -> f64 {
-    let p = cols.len();
-    let mut a = vec![vec![0.0; p]; p];
-    let mut b = vec![0.0; p];
-    for i in 0..p {
-        b[i] = cols[i].iter().zip(y).map(|(x, y)| x * y).sum();
-        for j in i..p {
-            a[i][j] = cols[i].iter().zip(&cols[j]).map(|(x, z)| x * z).sum();
-            a[j][i] = a[i][j];
-        }
-    }
-    for (i, row) in a.iter_mut().enumerate() {
-        row[i] += 1e-9 * row[i].abs().max(1e-12);
-    }
-    // Cholesky a = l lᵀ
-    let mut l = vec![vec![0.0; p]; p];
-    for i in 0..p {
-        for j in 0..=i {
-            let s: f64 = a[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
-            l[i][j] = if i == j {
-                s.max(1e-300).sqrt()
-            } else {
-                s / l[j][j]
-            };
-        }
-    }
-    let mut z = vec![0.0; p];
-    for i in 0..p {
-        z[i] = (b[i] - (0..i).map(|k| l[i][k] * z[k]).sum::<f64>()) / l[i][i];
-    }
-    let mut th = vec![0.0; p];
-    for i in (0..p).rev() {
-        th[i] = (z[i] - (i + 1..p).map(|k| l[k][i] * th[k]).sum::<f64>()) / l[i][i];
-    }
-    (0..y.len())
-        .map(|t| {
-            let e = y[t] - (0..p).map(|i| th[i] * cols[i][t]).sum::<f64>();
-            e * e
-        })
-        .sum()
-}
-
-/// The ratio for `valve`, against OP's residual sum of squares `with_op`.
-fn llr(pv: &[f64], with_op: f64, valve: &[f64], integrating: bool) -> f64 {
-    let with_valve = sse(pv, &regressors(valve, integrating));
-    pv.len() as f64 / 2.0 * (with_op / with_valve.max(f64::MIN_POSITIVE)).ln()
-}
+/// The filter bank (time constants and delays, samples).
+const BANK: Bank = Bank {
+    taus: &[0.3, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0],
+    delays: &[2, 3, 5, 8],
+};
 
 struct Row {
     class: String,
@@ -133,15 +47,15 @@ struct Row {
 
 fn judge(l: &BenchmarkLoop) -> Row {
     let d = &l.data;
-    let with_op = sse(&d.pv, &regressors(&d.op, l.integrating));
-    let oracle = llr(&d.pv, with_op, &d.mv, l.integrating);
+    let fit = CleanFit::new(&d.pv, l.integrating, BANK);
+    let with_op = fit.sse(&d.op);
+    let oracle = fit.llr(with_op, &d.mv);
     let req = CompareRequest {
         ts: l.ts(),
         integrating: Some(l.integrating),
         ..CompareRequest::default()
     };
-    let fitted = compare_fits(&d.op, &d.pv, &req)
-        .map(|f| llr(&d.pv, with_op, &f.mv_stiction, l.integrating));
+    let fitted = compare_fits(&d.op, &d.pv, &req).map(|f| fit.llr(with_op, &f.mv_stiction));
     let (record, dreq) = (catalogue_loop::record(l), catalogue_loop::request(l));
     let model_vote = diagnose(&record, &dreq).ok().and_then(|g| {
         g.families
