@@ -16,6 +16,8 @@
 mod catalogue_loop;
 #[path = "common/clean_fit.rs"]
 mod clean_fit;
+#[path = "common/study_args.rs"]
+mod study_args;
 
 use clean_fit::{Bank, CleanFit};
 use rayon::prelude::*;
@@ -24,6 +26,7 @@ use stiction_core::diagnose::{diagnose, Family, Verdict, Vote};
 use stiction_core::estimate::exact::stenman_walk;
 use stiction_core::models::Model;
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, Set, Suite, Truth};
+use study_args::StudyArgs;
 
 /// The filter bank (time constants and delays, samples).
 const BANK: Bank = Bank {
@@ -237,33 +240,14 @@ fn table(rows: &[Row], set: Set, suite: Suite) -> String {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let value = |flag: &str| {
-        args.iter()
-            .position(|a| a == flag)
-            .and_then(|i| args.get(i + 1))
-    };
-    let set = if args.iter().any(|a| a == "--benchmark") {
-        Set::Benchmark
-    } else {
-        Set::Calibration
-    };
-    let suite = match value("--suite").map(String::as_str) {
+    let args = StudyArgs::from_env("clean_walk");
+    let set = args.set();
+    let suite = match args.value("--suite") {
         None | Some("routine") => Suite::Routine,
         Some("fast") => Suite::Fast,
-        Some(other) => {
-            eprintln!("clean_walk: --suite {other}: use routine or fast");
-            std::process::exit(2)
-        }
+        Some(other) => args.fail(&format!("--suite {other}: use routine or fast")),
     };
     let loops = catalogue::catalogue(suite, set);
     let rows: Vec<Row> = loops.par_iter().map(judge).collect();
-    let md = table(&rows, set, suite);
-    match value("--out") {
-        Some(path) => std::fs::write(path, &md).unwrap_or_else(|e| {
-            eprintln!("clean_walk: {path}: cannot write: {e}");
-            std::process::exit(1)
-        }),
-        None => print!("{md}"),
-    }
+    args.emit(&table(&rows, set, suite));
 }

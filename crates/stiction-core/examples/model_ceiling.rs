@@ -20,6 +20,8 @@
 mod catalogue_loop;
 #[path = "common/clean_fit.rs"]
 mod clean_fit;
+#[path = "common/study_args.rs"]
+mod study_args;
 
 use clean_fit::{Bank, CleanFit};
 
@@ -28,6 +30,7 @@ use std::fmt::Write as _;
 use stiction_core::diagnose::{diagnose, Vote};
 use stiction_core::quantify::{compare_fits, CompareRequest};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, Set, Suite, Truth};
+use study_args::StudyArgs;
 
 /// The log-likelihood ratio a loop must reach to count as "the data show the valve".
 const SHOWS: f64 = 20.0;
@@ -73,16 +76,8 @@ fn judge(l: &BenchmarkLoop) -> Row {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let set = if args.iter().any(|a| a == "--benchmark") {
-        Set::Benchmark
-    } else {
-        Set::Calibration
-    };
-    let out = args
-        .iter()
-        .position(|a| a == "--out")
-        .and_then(|i| args.get(i + 1));
+    let args = StudyArgs::from_env("model_ceiling");
+    let set = args.set();
     let loops = catalogue::catalogue(Suite::Routine, set);
     let rows: Vec<Row> = loops.par_iter().map(judge).collect();
     let mut classes: Vec<&str> = Vec::new();
@@ -114,11 +109,5 @@ fn main() {
             o[o.len() / 2]
         );
     }
-    match out {
-        Some(path) => std::fs::write(path, &md).unwrap_or_else(|e| {
-            eprintln!("model_ceiling: {path}: cannot write: {e}");
-            std::process::exit(1)
-        }),
-        None => print!("{md}"),
-    }
+    args.emit(&md);
 }

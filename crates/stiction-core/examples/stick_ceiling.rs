@@ -20,6 +20,8 @@
 
 #[path = "common/catalogue_loop.rs"]
 mod catalogue_loop;
+#[path = "common/study_args.rs"]
+mod study_args;
 
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -27,6 +29,7 @@ use stiction_core::diagnose::evidence::stick_slip::{OP_TRAVEL_SIGMAS, PV_BAND_SI
 use stiction_core::diagnose::{diagnose, noise_std, Family, Vote};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, Set, Suite, Truth};
 use stiction_core::sim::Process;
+use study_args::StudyArgs;
 
 /// Sticks a loop needs for the family's stiction vote (`stick_slip::MIN_EPISODES`).
 const NEEDED: usize = stiction_core::diagnose::evidence::stick_slip::MIN_EPISODES;
@@ -140,16 +143,8 @@ fn judge(l: &BenchmarkLoop) -> Row {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let set = if args.iter().any(|a| a == "--benchmark") {
-        Set::Benchmark
-    } else {
-        Set::Calibration
-    };
-    let out = args
-        .iter()
-        .position(|a| a == "--out")
-        .and_then(|i| args.get(i + 1));
+    let args = StudyArgs::from_env("stick_ceiling");
+    let set = args.set();
     let loops: Vec<BenchmarkLoop> = catalogue::catalogue(Suite::Routine, set)
         .into_iter()
         .filter(|l| l.truth == Truth::Sticky)
@@ -170,13 +165,7 @@ fn main() {
         let _ = writeln!(md, "| {g} | {} |", line(&of));
     }
     let _ = writeln!(md, "| all sticky | both | {} |", line(&all));
-    match out {
-        Some(path) => std::fs::write(path, &md).unwrap_or_else(|e| {
-            eprintln!("stick_ceiling: {path}: cannot write: {e}");
-            std::process::exit(1)
-        }),
-        None => print!("{md}"),
-    }
+    args.emit(&md);
 }
 
 /// One table row's figures for the loops `of`.
