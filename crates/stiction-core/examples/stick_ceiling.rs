@@ -28,7 +28,6 @@ use std::fmt::Write as _;
 use stiction_core::diagnose::evidence::stick_slip::{OP_TRAVEL_SIGMAS, PV_BAND_SIGMAS};
 use stiction_core::diagnose::{diagnose, noise_std, Family, Vote};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, Set, Suite, Truth};
-use stiction_core::sim::Process;
 use study_args::StudyArgs;
 
 /// Sticks a loop needs for the family's stiction vote (`stick_slip::MIN_EPISODES`).
@@ -54,14 +53,6 @@ fn smooth(x: &[f64], w: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The process gain in units of the judged signal per OP unit, and its dead time in seconds.
-fn gain_and_delay(p: &Process, ts: f64) -> (f64, f64) {
-    match *p {
-        Process::Foptd { k, delay, .. } | Process::Soptd { k, delay, .. } => (k, delay),
-        Process::Integrating { k, delay } => (k * ts, delay),
-    }
-}
-
 /// The stuck intervals `[i, j)`: MV holds exactly for at least 3 samples, and the record goes on.
 fn stuck_intervals(mv: &[f64]) -> Vec<(usize, usize)> {
     let mut out = Vec::new();
@@ -82,7 +73,9 @@ fn stuck_intervals(mv: &[f64]) -> Vec<(usize, usize)> {
 fn judge(l: &BenchmarkLoop) -> Row {
     let d = &l.data;
     let ts = l.ts();
-    let (gain, delay) = gain_and_delay(&l.setup.process, ts);
+    // the process gain in units of the judged signal per OP unit (a level's rate per sample)
+    let p = &l.setup.process;
+    let gain = p.gain() * if p.is_integrating() { ts } else { 1.0 };
     // the judged signal: PV, or a level's smoothed rate of change (as the family judges it)
     let y = if l.integrating {
         let rate: Vec<f64> = std::iter::once(0.0)
@@ -95,7 +88,7 @@ fn judge(l: &BenchmarkLoop) -> Row {
     let band = PV_BAND_SIGMAS * noise_std(&y);
     let op_noise = noise_std(&d.op);
     let (op_s, y_s) = (smooth(&d.op, 5), smooth(&y, 5));
-    let dead = (delay / ts).round() as usize;
+    let dead = (p.delay() / ts).round() as usize;
     let mut row = Row {
         group: format!("{} | {} at {} s", l.class, d.op.len(), ts),
         stuck: 0,
