@@ -135,6 +135,23 @@ pub fn share(y: &[(f64, Complex64)], x: &[(f64, Complex64)]) -> f64 {
     (num / den.max(f64::MIN_POSITIVE)).sqrt()
 }
 
+/// [`share`] less what white measurement noise of standard deviation `sigma` puts into every
+/// cycle's fundamental, in `y` and in `x`: the least-squares amplitude over a cycle of `N` samples
+/// scatters by `4 σ² / N` in power, so a residual of noise alone is no share. When `x`'s cycles
+/// hold no more power than that noise, [`share`] as it is.
+pub fn share_above_noise(y: &[(f64, Complex64)], x: &[(f64, Complex64)], sigma: f64) -> f64 {
+    let power = |c: &[(f64, Complex64)]| -> f64 {
+        c.iter()
+            .map(|(th, z)| z.norm_sqr() - 4.0 * sigma * sigma * th / (2.0 * std::f64::consts::PI))
+            .sum()
+    };
+    let cycle = power(x);
+    if !(cycle > 0.0) {
+        return share(y, x);
+    }
+    (power(y).max(0.0) / cycle).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -181,5 +198,30 @@ mod tests {
         let wandering = measure(&wave(&|k| 2.0 + (k / 97.0).sin() * (k / 411.0).cos())).unwrap();
         assert!(wandering.scatter > 0.15, "{wandering:?}");
         assert!(measure(&wave(&|_| 1.0)[..150]).is_none());
+    }
+
+    #[test]
+    fn white_noise_is_no_share_of_a_cycle() {
+        let period = 20.0;
+        let mut rng = crate::rng::seeded(7);
+        let pv: Vec<f64> = (0..2000)
+            .map(|k| (2.0 * PI * k as f64 / period).sin())
+            .collect();
+        let noise: Vec<f64> = (0..2000)
+            .map(|_| 0.5 * crate::rng::gaussian(&mut rng))
+            .collect();
+        let noisy: Vec<f64> = pv.iter().zip(&noise).map(|(a, b)| a + b).collect();
+        let c = Cycles::find(&pv, period).unwrap();
+        let (cp, cn) = (c.coefficients(&noisy), c.coefficients(&noise));
+        // a residual of noise alone: about sqrt(4 σ² / N) = 0.22 of a unit cycle, and nothing
+        // once the noise's own power is taken off
+        let raw = share(&cn, &cp);
+        let above = share_above_noise(&cn, &cp, 0.5);
+        assert!((0.17..0.28).contains(&raw), "{raw}");
+        assert!(above < 0.08, "{above}");
+        // a residual that is a tenth of the cycle stays one
+        let tenth: Vec<f64> = pv.iter().zip(&noise).map(|(a, b)| 0.1 * a + b).collect();
+        let part = share_above_noise(&c.coefficients(&tenth), &cp, 0.5);
+        assert!((0.05..0.15).contains(&part), "{part}");
     }
 }

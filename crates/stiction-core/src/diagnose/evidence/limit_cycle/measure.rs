@@ -2,11 +2,11 @@
 //! describing function closes the harmonic balance.
 
 use super::{
-    DescribingBand, LoopEvidence, ProcessSource, CALIBRATION, LIMIT_NEAR, MIN_PI_R2, PERIOD_MATCH,
-    PI_CUTOFF,
+    DescribingBand, LoopEvidence, ProcessSource, CALIBRATION, LIMIT_NEAR, MIN_HARMONICS, MIN_PI_R2,
+    NOISE_FREE_CYCLE, PERIOD_MATCH, PI_CUTOFF,
 };
 use crate::diagnose::evidence::Context;
-use crate::loop_analysis::cycle::share;
+use crate::loop_analysis::cycle::{share, share_above_noise};
 use crate::loop_analysis::describing::{harmonic_balance, nearest, valve_loci, ValveLocus};
 use crate::loop_analysis::frequency::pi_response;
 use crate::loop_analysis::{identify_pi_below, AmplitudeTrend, Complex64, Cycles, OpenLoop};
@@ -71,7 +71,15 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
     } else {
         pv.to_vec()
     };
-    let residual_share = share(&cycles.coefficients(&residual), &pv_c);
+    // PV's measurement noise in a cycle's fundamental is no unexplained input; the noise is
+    // estimated from PV's differences, which a cycle of few samples would swell, so only on
+    // cycles of at least NOISE_FREE_CYCLE samples
+    let residual_c = cycles.coefficients(&residual);
+    let residual_share = if cycles.period() >= NOISE_FREE_CYCLE {
+        share_above_noise(&residual_c, &pv_c, ctx.pv_noise)
+    } else {
+        share(&residual_c, &pv_c)
+    };
     // what the PI makes of the error's cycles, against OP's
     let unexplained: Vec<(f64, Complex64)> = cycles
         .coefficients(&ctx.error[s..e])
@@ -84,10 +92,15 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
     let amplitude = AmplitudeTrend::of(&amps);
     let op_amplitude = amps.iter().sum::<f64>() / amps.len() as f64;
     let pv_amplitude = pv_c.iter().map(|(_, z)| z.norm()).sum::<f64>() / pv_c.len() as f64;
-    let harmonics = [op, pv]
-        .iter()
-        .filter_map(|x| harmonic_distortion(x, 1.0 / cycles.period(), 5))
-        .reduce(f64::max);
+    let harmonic_count = measurable_harmonics(cycles.period());
+    let harmonics = (harmonic_count >= MIN_HARMONICS)
+        .then(|| {
+            [op, pv]
+                .iter()
+                .filter_map(|x| harmonic_distortion(x, 1.0 / cycles.period(), harmonic_count))
+                .reduce(f64::max)
+        })
+        .flatten();
     let open = OpenLoop { process, pi: &pi };
     let margins = open.margins(theta / 20.0, ts);
     let needed = -1.0 / open.response(theta);
@@ -101,6 +114,12 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
         op_amplitude,
         pv_amplitude,
         harmonics,
+        samples_per_cycle: cycles.period(),
+        harmonic_count: if harmonics.is_some() {
+            harmonic_count
+        } else {
+            0
+        },
         residual_share,
         controller_residual_share,
         op_at_limit: at_limit(op, period / ts, ctx.req.op_range),
@@ -111,6 +130,12 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
         caveat,
         calibration: CALIBRATION.into(),
     })
+}
+
+/// How many harmonics (up to 5) of a cycle of `samples_per_cycle` samples lie, with their bands of
+/// ±0.3 of the fundamental, below the Nyquist frequency (as `harmonic_distortion` requires).
+pub(super) fn measurable_harmonics(samples_per_cycle: f64) -> usize {
+    ((0.5 * samples_per_cycle - 0.3).floor().max(0.0) as usize).min(5)
 }
 
 /// Share of the cycles whose OP comes within [`LIMIT_NEAR`] of the range's ends (the analysed

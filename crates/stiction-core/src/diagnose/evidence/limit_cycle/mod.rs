@@ -62,6 +62,10 @@ pub const LINEAR_GAIN: f64 = 0.15;
 pub const MAX_DISTANCE: f64 = 0.2;
 /// Largest share of the PV's cycle that OP may leave unexplained through the fitted process.
 pub const MAX_RESIDUAL: f64 = 0.35;
+/// The PV's measurement noise is taken off the unexplained share on cycles of at least this many
+/// samples (on shorter ones the cycle itself swells the noise estimate from PV's differences: at
+/// 12 samples a noise-free sinusoid passes for noise worth 0.07 of its cycle, at 8 samples 0.22).
+pub const NOISE_FREE_CYCLE: f64 = 12.0;
 /// The identified linear loop must be stable: a gain margin above this.
 pub const MIN_MARGIN: f64 = 1.0;
 /// OP within this share of its range from either end counts as at a limit ...
@@ -77,6 +81,10 @@ pub const UNSTEADY_CHANGE: f64 = 0.5;
 pub const UNSTEADY_SCATTER: f64 = 0.25;
 /// A predicted period within this factor of the observed one matches it.
 pub const PERIOD_MATCH: f64 = 1.25;
+/// The harmonics are measured up to the 5th, or as many as lie below the Nyquist frequency; under
+/// this many (the 3rd, where a symmetric valve cycle puts most of its distortion) they are not
+/// measured and not asked for.
+pub const MIN_HARMONICS: usize = 3;
 /// The controller is identified below this many times the cycle's frequency.
 pub const PI_CUTOFF: f64 = 4.0;
 /// Without a setpoint the stiction vote's strength is multiplied by this (a cascade's moving
@@ -139,12 +147,21 @@ pub struct LoopEvidence {
     pub op_amplitude: f64,
     /// Mean amplitude of PV's fundamental per cycle, PV units.
     pub pv_amplitude: f64,
-    /// Harmonic distortion of the cycle (the larger of OP's and PV's; harmonics 2 to 5 over the
-    /// fundamental's power).
+    /// Harmonic distortion of the cycle (the larger of OP's and PV's; harmonics 2 to
+    /// `harmonic_count` over the fundamental's power). `None` when fewer than [`MIN_HARMONICS`]
+    /// lie below the Nyquist frequency: a cycle of under 7 samples cannot show a valve's jumps, and
+    /// the family then does not ask for them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub harmonics: Option<f64>,
+    /// Samples per cycle (the period over the sampling interval).
+    #[serde(default)]
+    pub samples_per_cycle: f64,
+    /// The highest harmonic measured (5, or fewer for a cycle of under 11 samples; 0 when none was).
+    #[serde(default)]
+    pub harmonic_count: usize,
     /// Share of the PV's cycle (RMS over the cycles of its fundamental) that OP does not explain
-    /// through the fitted process.
+    /// through the fitted process, above what PV's measurement noise puts there (on cycles of at
+    /// least [`NOISE_FREE_CYCLE`] samples).
     pub residual_share: f64,
     /// Share of OP's cycle that the identified PI does not explain from the error's cycle (a
     /// setpoint moving unrecorded, or a controller that is not a PI).
@@ -180,7 +197,7 @@ impl EvidenceFamily for LimitCycle {
         let statistic = "the phase lag (degrees) a valve must add for the identified linear loop to sustain the observed cycle";
         let threshold = format!(
             "stiction when the lag is {MIN_LAG} to {MAX_LAG} degrees and a sticky valve's describing function gives it (within {MAX_DISTANCE}), \
-             the cycle has harmonics (at least {} of the fundamental's power), OP explains all but {:.0} % of the PV's cycle, \
+             the cycle has harmonics (at least {} of the fundamental's power, when the 3rd lies below the Nyquist frequency), OP explains all but {:.0} % of the PV's cycle, \
              the identified loop's gain margin exceeds {MIN_MARGIN} and OP stays off its limits; none when OP reaches a limit of its range in the cycle \
              (a loop that needs no valve, lag under {LINEAR_LAG} degrees, is left undetermined)",
             crate::diagnose::evidence::shape::SINUSOIDAL_HARMONICS,
@@ -200,10 +217,21 @@ fn vote(e: LoopEvidence, statistic: &str, threshold: String) -> FamilyEvidence {
         .amplitude
         .as_ref()
         .map_or((0.0, 0.0), |a| (a.change, a.scatter));
-    let h = e.harmonics.unwrap_or(0.0);
+    let harmonics_text = match e.harmonics {
+        Some(h) if e.harmonic_count < 5 => format!("harmonics {h:.3} (2 to {})", e.harmonic_count),
+        Some(h) => format!("harmonics {h:.3}"),
+        None => format!(
+            "harmonics not measured (a cycle of {:.1} samples puts the 3rd above the Nyquist frequency)",
+            e.samples_per_cycle
+        ),
+    };
+    // a cycle too short in samples to show harmonics is not taken for a sinusoid
+    let distorted = e
+        .harmonics
+        .is_none_or(|h| h >= crate::diagnose::evidence::shape::SINUSOIDAL_HARMONICS);
     let dist = e.describing.as_ref().map_or(f64::INFINITY, |d| d.distance);
     let facts = format!(
-        "cycle of {:.0} s, OP amplitude {:.2}; the loop needs a valve gain {:.2} and lag {lag:.0}°{}; harmonics {h:.3}; \
+        "cycle of {:.0} s, OP amplitude {:.2}; the loop needs a valve gain {:.2} and lag {lag:.0}°{}; {harmonics_text}; \
          {:.0} % of the PV's cycle unexplained by OP; amplitude {:+.0} % over {} cycles, scatter {:.0} %; gain margin {}; PI Kc {:.3}, Ti {} (R² {:.2})",
         e.period,
         e.op_amplitude,
@@ -245,7 +273,7 @@ fn vote(e: LoopEvidence, statistic: &str, threshold: String) -> FamilyEvidence {
             ),
         )
     } else if valve_lag
-        && h >= crate::diagnose::evidence::shape::SINUSOIDAL_HARMONICS
+        && distorted
         && e.residual_share <= MAX_RESIDUAL
         && gm.is_none_or(|g| g > MIN_MARGIN)
     {
@@ -279,7 +307,7 @@ fn vote(e: LoopEvidence, statistic: &str, threshold: String) -> FamilyEvidence {
         if !valve_lag {
             missing.push(format!("no sticky valve gives the needed describing function (lag {lag:.0}°, {dist:.2} away)"));
         }
-        if h < crate::diagnose::evidence::shape::SINUSOIDAL_HARMONICS {
+        if !distorted {
             missing.push("the cycle is sinusoidal where a valve's lag would distort it".into());
         }
         if e.residual_share > MAX_RESIDUAL {
@@ -344,5 +372,54 @@ mod tests {
         );
         // without the loop family the same votes against decide
         assert_eq!(decide(&against, true).verdict, Verdict::NoStiction);
+    }
+
+    /// A fast loop's cycle (fast-c-0004 of the plant benchmark: Stenman band 4.65 %, sampled every
+    /// 5 s, a cycle of 8.8 samples), its harmonics left out.
+    const SHORT_CYCLE: &str = r#"{"controller": {"kc": 0.65, "ki": 0.759, "ti": 4.278, "action": "reverse", "lag": 0, "r2": 0.83, "samples": 1999}, "setpoint_recorded": true, "process": "stiction_fit", "margins": {"gain_margin": 1.458, "critical_period": 28.194, "phase_margin": 21.054, "modulus_margin": 0.247}, "period": 44.1, "op_amplitude": 2.807, "pv_amplitude": 1.87, "samples_per_cycle": 8.82, "harmonic_count": 0, "residual_share": 0.284, "controller_residual_share": 0.153, "op_at_limit": 0.0, "needed_gain": 0.843, "needed_lag_degrees": 28.747, "describing": {"model": "kano", "slip_ratio": 0.5, "band": 3.477, "band_percent_of_span": 3.477, "amplitude_over_band": 0.807, "distance": 0.013, "predicted_period": 44.98, "period_matches": true}, "calibration": ""}"#;
+
+    fn judged(harmonics: Option<f64>, harmonic_count: usize) -> FamilyEvidence {
+        let mut e: LoopEvidence = serde_json::from_str(SHORT_CYCLE).unwrap();
+        e.harmonics = harmonics;
+        e.harmonic_count = harmonic_count;
+        super::vote(e, "", String::new())
+    }
+
+    #[test]
+    fn harmonics_are_measured_up_to_the_nyquist_frequency() {
+        assert_eq!(measure::measurable_harmonics(20.0), 5);
+        assert_eq!(measure::measurable_harmonics(11.0), 5);
+        assert_eq!(measure::measurable_harmonics(8.82), 4);
+        assert_eq!(measure::measurable_harmonics(7.0), 3);
+        assert_eq!(measure::measurable_harmonics(6.5), 2);
+    }
+
+    #[test]
+    fn a_cycle_too_short_for_harmonics_is_not_called_sinusoidal() {
+        // distorted over the harmonics that could be measured: the valve's lag closes the balance
+        let measured = judged(Some(0.06), 4);
+        assert_eq!(measured.vote, Vote::Stiction, "{}", measured.note);
+        assert!(
+            measured.note.contains("harmonics 0.060 (2 to 4)"),
+            "{}",
+            measured.note
+        );
+        // none measurable: not asked for, and said so
+        let unmeasured = judged(None, 0);
+        assert_eq!(unmeasured.vote, Vote::Stiction, "{}", unmeasured.note);
+        assert!(
+            unmeasured.note.contains("harmonics not measured"),
+            "{}",
+            unmeasured.note
+        );
+        assert!(
+            !unmeasured.note.contains("sinusoidal"),
+            "{}",
+            unmeasured.note
+        );
+        // measured and sinusoidal: no valve
+        let sine = judged(Some(0.001), 5);
+        assert_eq!(sine.vote, Vote::Undetermined);
+        assert!(sine.note.contains("sinusoidal"), "{}", sine.note);
     }
 }
