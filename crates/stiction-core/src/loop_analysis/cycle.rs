@@ -82,7 +82,7 @@ impl AmplitudeTrend {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cycles {
     /// `[start, end)` of each whole cycle (the first and last of the record left out: the
-    /// filter's ends).
+    /// filter's ends; crossings closer than half the period are no cycle).
     pub bounds: Vec<(usize, usize)>,
 }
 
@@ -94,7 +94,15 @@ impl Cycles {
         let ups: Vec<usize> = (1..y.len())
             .filter(|&k| y[k - 1] < 0.0 && y[k] >= 0.0)
             .collect();
-        let bounds: Vec<(usize, usize)> = ups.windows(2).map(|w| (w[0], w[1])).collect();
+        // a crossing pair closer than half the period (at least 3 samples) is the filtered
+        // signal's wiggle about zero, not a cycle: its fundamental would be no amplitude (a cycle
+        // of 2 samples has none), so it is left out
+        let shortest = ((0.5 * period).ceil() as usize).max(3);
+        let bounds: Vec<(usize, usize)> = ups
+            .windows(2)
+            .map(|w| (w[0], w[1]))
+            .filter(|(a, b)| b - a >= shortest)
+            .collect();
         if bounds.len() < 6 {
             return None;
         }
@@ -223,5 +231,26 @@ mod tests {
         let tenth: Vec<f64> = pv.iter().zip(&noise).map(|(a, b)| 0.1 * a + b).collect();
         let part = share_above_noise(&c.coefficients(&tenth), &cp, 0.5);
         assert!((0.05..0.15).contains(&part), "{part}");
+    }
+
+    #[test]
+    fn a_wiggle_about_zero_is_no_cycle() {
+        // a cycle of 8.8 samples under heavy noise: the band-passed signal sometimes crosses zero
+        // twice within a sample or two; such a "cycle" has no fundamental and would void the
+        // amplitude trend
+        let period = 8.8;
+        for seed in 0..20 {
+            let mut rng = crate::rng::seeded(seed);
+            let x: Vec<f64> = (0..2000)
+                .map(|k| {
+                    (2.0 * PI * k as f64 / period).sin() + 1.5 * crate::rng::gaussian(&mut rng)
+                })
+                .collect();
+            let c = Cycles::find(&x, period).unwrap();
+            assert!(c.bounds.iter().all(|(a, b)| b - a >= 5), "{:?}", c.bounds);
+            let amps: Vec<f64> = c.coefficients(&x).iter().map(|(_, z)| z.norm()).collect();
+            let trend = AmplitudeTrend::of(&amps).expect("every cycle has an amplitude");
+            assert!(trend.cycles > 100, "seed {seed}: {trend:?}");
+        }
     }
 }
