@@ -66,8 +66,13 @@ pub const MAX_RESIDUAL: f64 = 0.35;
 /// samples (on shorter ones the cycle itself swells the noise estimate from PV's differences: at
 /// 12 samples a noise-free sinusoid passes for noise worth 0.07 of its cycle, at 8 samples 0.22).
 pub const NOISE_FREE_CYCLE: f64 = 12.0;
-/// The identified linear loop must be stable: a gain margin above this.
-pub const MIN_MARGIN: f64 = 1.0;
+/// The identified linear loop's gain margin must exceed this. A little under 1 is allowed: a sticky
+/// valve's describing function has a gain under 1, so a loop unstable with a valve that follows OP
+/// can hold a cycle with a sticky one, and the closed-loop fit puts some of the valve's lag into
+/// the process. Set on the loop benchmark: at 0.8 no look-alike gains a loop vote there or in the
+/// plant benchmark's calibration sets, and the family votes stiction on 69 of the 240 sticky loops
+/// instead of 56 at 1.0.
+pub const MIN_MARGIN: f64 = 0.8;
 /// OP within this share of its range from either end counts as at a limit ...
 pub const LIMIT_NEAR: f64 = 0.01;
 /// ... when this share of the cycles reach it.
@@ -287,7 +292,13 @@ fn vote(e: LoopEvidence, statistic: &str, threshold: String) -> FamilyEvidence {
             Vote::Stiction,
             s,
             format!(
-                "the identified linear loop is stable and cannot sustain this cycle; a sticky valve's lag closes the balance{}",
+                "{}; a sticky valve's lag closes the balance{}",
+                match gm {
+                    Some(g) if g <= 1.0 => format!(
+                        "the identified linear loop is at or just past its stability limit (gain margin {g:.2}) and cannot sustain this cycle without a lag in the valve"
+                    ),
+                    _ => "the identified linear loop is stable and cannot sustain this cycle".into(),
+                },
                 if e.setpoint_recorded { "" } else { " (weakened: without a setpoint a cascade's moving setpoint cannot be ruled out)" }
             ),
         )
@@ -317,7 +328,9 @@ fn vote(e: LoopEvidence, statistic: &str, threshold: String) -> FamilyEvidence {
             ));
         }
         if gm.is_some_and(|g| g <= MIN_MARGIN) {
-            missing.push("the identified linear loop is unstable".into());
+            missing.push(format!(
+                "the identified linear loop is unstable (gain margin under {MIN_MARGIN})"
+            ));
         }
         (Vote::Undetermined, 0.0, missing.join("; "))
     };
@@ -421,5 +434,31 @@ mod tests {
         let sine = judged(Some(0.001), 5);
         assert_eq!(sine.vote, Vote::Undetermined);
         assert!(sine.note.contains("sinusoidal"), "{}", sine.note);
+    }
+
+    #[test]
+    fn a_loop_just_past_its_limit_still_needs_the_valves_lag() {
+        let with_margin = |g: f64| {
+            let mut e: LoopEvidence = serde_json::from_str(SHORT_CYCLE).unwrap();
+            e.harmonics = Some(0.06);
+            e.harmonic_count = 4;
+            e.margins.gain_margin = Some(g);
+            super::vote(e, "", String::new())
+        };
+        let near = with_margin(0.9);
+        assert_eq!(near.vote, Vote::Stiction, "{}", near.note);
+        assert!(
+            near.note
+                .contains("just past its stability limit (gain margin 0.90)"),
+            "{}",
+            near.note
+        );
+        let unstable = with_margin(0.7);
+        assert_eq!(unstable.vote, Vote::Undetermined);
+        assert!(
+            unstable.note.contains("unstable (gain margin under 0.8)"),
+            "{}",
+            unstable.note
+        );
     }
 }
