@@ -1,0 +1,111 @@
+//! The loop family's vote on fixed evidence.
+use super::*;
+use crate::diagnose::result::Verdict;
+use crate::diagnose::verdict::decide;
+
+fn vote(family: Family, vote: Vote, strength: f64) -> FamilyEvidence {
+    let mut f = FamilyEvidence::abstains(family, "", String::new(), String::new());
+    f.vote = vote;
+    f.strength = strength;
+    f
+}
+
+#[test]
+fn shape_and_fit_votes_against_do_not_outweigh_the_loop() {
+    // the issue: shape, fit and stick-slip read a near-sinusoid as linear
+    let against = [
+        vote(Family::Shape, Vote::NoStiction, 0.5),
+        vote(Family::Model, Vote::NoStiction, 0.6),
+        vote(Family::StickSlip, Vote::NoStiction, 0.5),
+    ];
+    let mut all = against.to_vec();
+    all.push(vote(Family::Loop, Vote::Stiction, 0.9));
+    assert_eq!(decide(&all, true).verdict, Verdict::Stiction);
+    // weak loop evidence (no setpoint): never a confident no, the conflict is named
+    let mut weak = against[..1].to_vec();
+    weak.push(vote(Family::Loop, Vote::Stiction, 0.36));
+    let d = decide(&weak, true);
+    assert_eq!(d.verdict, Verdict::Undetermined);
+    let reason = d.reason.unwrap();
+    assert!(
+        reason.contains("linear loop") && reason.contains("shape"),
+        "{reason}"
+    );
+    // without the loop family the same votes against decide
+    assert_eq!(decide(&against, true).verdict, Verdict::NoStiction);
+}
+
+/// A fast loop's cycle (fast-c-0004 of the plant benchmark: Stenman band 4.65 %, sampled every
+/// 5 s, a cycle of 8.8 samples), its harmonics left out.
+const SHORT_CYCLE: &str = r#"{"controller": {"kc": 0.65, "ki": 0.759, "ti": 4.278, "action": "reverse", "lag": 0, "r2": 0.83, "samples": 1999}, "setpoint_recorded": true, "process": "stiction_fit", "margins": {"gain_margin": 1.458, "critical_period": 28.194, "phase_margin": 21.054, "modulus_margin": 0.247}, "period": 44.1, "op_amplitude": 2.807, "pv_amplitude": 1.87, "samples_per_cycle": 8.82, "harmonic_count": 0, "residual_share": 0.284, "controller_residual_share": 0.153, "op_at_limit": 0.0, "needed_gain": 0.843, "needed_lag_degrees": 28.747, "describing": {"model": "kano", "slip_ratio": 0.5, "band": 3.477, "band_percent_of_span": 3.477, "amplitude_over_band": 0.807, "distance": 0.013, "predicted_period": 44.98, "period_matches": true}, "calibration": ""}"#;
+
+fn judged(harmonics: Option<f64>, harmonic_count: usize) -> FamilyEvidence {
+    let mut e: LoopEvidence = serde_json::from_str(SHORT_CYCLE).unwrap();
+    e.harmonics = harmonics;
+    e.harmonic_count = harmonic_count;
+    super::vote(e, "", String::new())
+}
+
+#[test]
+fn harmonics_are_measured_up_to_the_nyquist_frequency() {
+    assert_eq!(measure::measurable_harmonics(20.0), 5);
+    assert_eq!(measure::measurable_harmonics(11.0), 5);
+    assert_eq!(measure::measurable_harmonics(8.82), 4);
+    assert_eq!(measure::measurable_harmonics(7.0), 3);
+    assert_eq!(measure::measurable_harmonics(6.5), 2);
+}
+
+#[test]
+fn a_cycle_too_short_for_harmonics_is_not_called_sinusoidal() {
+    // distorted over the harmonics that could be measured: the valve's lag closes the balance
+    let measured = judged(Some(0.06), 4);
+    assert_eq!(measured.vote, Vote::Stiction, "{}", measured.note);
+    assert!(
+        measured.note.contains("harmonics 0.060 (2 to 4)"),
+        "{}",
+        measured.note
+    );
+    // none measurable: not asked for, and said so
+    let unmeasured = judged(None, 0);
+    assert_eq!(unmeasured.vote, Vote::Stiction, "{}", unmeasured.note);
+    assert!(
+        unmeasured.note.contains("harmonics not measured"),
+        "{}",
+        unmeasured.note
+    );
+    assert!(
+        !unmeasured.note.contains("sinusoidal"),
+        "{}",
+        unmeasured.note
+    );
+    // measured and sinusoidal: no valve
+    let sine = judged(Some(0.001), 5);
+    assert_eq!(sine.vote, Vote::Undetermined);
+    assert!(sine.note.contains("sinusoidal"), "{}", sine.note);
+}
+
+#[test]
+fn a_loop_just_past_its_limit_still_needs_the_valves_lag() {
+    let with_margin = |g: f64| {
+        let mut e: LoopEvidence = serde_json::from_str(SHORT_CYCLE).unwrap();
+        e.harmonics = Some(0.06);
+        e.harmonic_count = 4;
+        e.margins.gain_margin = Some(g);
+        super::vote(e, "", String::new())
+    };
+    let near = with_margin(0.9);
+    assert_eq!(near.vote, Vote::Stiction, "{}", near.note);
+    assert!(
+        near.note
+            .contains("just past its stability limit (gain margin 0.90)"),
+        "{}",
+        near.note
+    );
+    let unstable = with_margin(0.7);
+    assert_eq!(unstable.vote, Vote::Undetermined);
+    assert!(
+        unstable.note.contains("unstable (gain margin under 0.8)"),
+        "{}",
+        unstable.note
+    );
+}
