@@ -132,3 +132,46 @@ fn no_oscillation_no_loop_vote() {
         f.note
     );
 }
+
+#[test]
+fn where_the_fit_misses_short_sticks_the_describing_functions_band_is_reported() {
+    // fast-c-0004 of the plant benchmark: a flow loop sampled every 5 s under a controller
+    // running every 3 s, a valve lag of 1.2 s, a Stenman band of 4.65 %. The closed-loop estimate
+    // reads its short sticks as a band of 1.8 %; the describing function gives 3.6 %.
+    let l = stiction_core::sim::catalogue::find("fast-c-0004").unwrap();
+    let d = &l.data;
+    let rec = LoopRecord {
+        op: &d.op,
+        pv: &d.pv,
+        sp: Some(&d.sp),
+        mv: None,
+        time: Some(&d.t),
+        auto: None,
+    };
+    let req = DiagnoseRequest {
+        ts: l.ts(),
+        ..DiagnoseRequest::default()
+    };
+    let d = diagnose(&rec, &req).unwrap();
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let band = d.band.as_ref().unwrap();
+    assert_eq!(band.source, BandSource::DescribingFunction, "{band:?}");
+    assert!(
+        (4.65 / 1.5..4.65 * 1.5).contains(&band.band_percent_of_span),
+        "{band:?}"
+    );
+    let closed = band
+        .others
+        .iter()
+        .find(|(s, _)| *s == BandSource::ClosedLoop)
+        .map(|(_, v)| *v)
+        .unwrap();
+    assert!(closed < band.band_percent_of_span / 1.5, "{band:?}");
+    assert!(
+        d.warnings
+            .iter()
+            .any(|w| w.contains("differ by more than 1.5x")),
+        "{:?}",
+        d.warnings
+    );
+}
