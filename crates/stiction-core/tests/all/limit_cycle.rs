@@ -33,21 +33,25 @@ fn fast_loop(d: f64, kc: f64, disturbance: Option<Signal>) -> LoopData {
     cl.run().unwrap()
 }
 
-fn judge(l: &LoopData) -> Diagnosis {
-    let rec = LoopRecord {
+/// The loop's record as `stiction diagnose loop.csv --sp sp` reads it.
+fn record(l: &LoopData) -> LoopRecord<'_> {
+    LoopRecord {
         op: &l.op,
         pv: &l.pv,
         sp: Some(&l.sp),
         mv: None,
         time: Some(&l.t),
         auto: None,
-    };
+    }
+}
+
+fn judge(l: &LoopData) -> Diagnosis {
     let req = DiagnoseRequest {
         ts: 2.0,
         quantify: false,
         ..DiagnoseRequest::default()
     };
-    diagnose(&rec, &req).unwrap()
+    diagnose(&record(l), &req).unwrap()
 }
 
 fn loop_family(d: &Diagnosis) -> &FamilyEvidence {
@@ -139,20 +143,11 @@ fn where_the_fit_misses_short_sticks_the_describing_functions_band_is_reported()
     // running every 3 s, a valve lag of 1.2 s, a Stenman band of 4.65 %. The closed-loop estimate
     // reads its short sticks as a band of 1.8 %; the describing function gives 3.6 %.
     let l = stiction_core::sim::catalogue::find("fast-c-0004").unwrap();
-    let d = &l.data;
-    let rec = LoopRecord {
-        op: &d.op,
-        pv: &d.pv,
-        sp: Some(&d.sp),
-        mv: None,
-        time: Some(&d.t),
-        auto: None,
-    };
     let req = DiagnoseRequest {
         ts: l.ts(),
         ..DiagnoseRequest::default()
     };
-    let d = diagnose(&rec, &req).unwrap();
+    let d = diagnose(&record(&l.data), &req).unwrap();
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
     let band = d.band.as_ref().unwrap();
     assert_eq!(band.source, BandSource::DescribingFunction, "{band:?}");
