@@ -61,7 +61,8 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
     let Some(cycles) = Cycles::find(op, period / ts) else {
         return Err("fewer than 4 whole cycles of OP to measure".into());
     };
-    let period = cycles.period() * ts;
+    let samples_per_cycle = cycles.period();
+    let period = samples_per_cycle * ts;
     let theta = 2.0 * PI * ts / period;
     let op_c = cycles.coefficients(op);
     let pv_c = cycles.coefficients(pv);
@@ -75,7 +76,7 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
     // estimated from PV's differences, which a cycle of few samples would swell, so only on
     // cycles of at least NOISE_FREE_CYCLE samples
     let residual_c = cycles.coefficients(&residual);
-    let residual_share = if cycles.period() >= NOISE_FREE_CYCLE {
+    let residual_share = if samples_per_cycle >= NOISE_FREE_CYCLE {
         share_above_noise(&residual_c, &pv_c, ctx.pv_noise)
     } else {
         share(&residual_c, &pv_c)
@@ -92,12 +93,12 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
     let amplitude = AmplitudeTrend::of(&amps);
     let op_amplitude = amps.iter().sum::<f64>() / amps.len() as f64;
     let pv_amplitude = pv_c.iter().map(|(_, z)| z.norm()).sum::<f64>() / pv_c.len() as f64;
-    let harmonic_count = measurable_harmonics(cycles.period());
+    let harmonic_count = measurable_harmonics(samples_per_cycle);
     let harmonics = (harmonic_count >= MIN_HARMONICS)
         .then(|| {
             [op, pv]
                 .iter()
-                .filter_map(|x| harmonic_distortion(x, 1.0 / cycles.period(), harmonic_count))
+                .filter_map(|x| harmonic_distortion(x, 1.0 / samples_per_cycle, harmonic_count))
                 .reduce(f64::max)
         })
         .flatten();
@@ -114,7 +115,7 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
         op_amplitude,
         pv_amplitude,
         harmonics,
-        samples_per_cycle: cycles.period(),
+        samples_per_cycle,
         harmonic_count: if harmonics.is_some() {
             harmonic_count
         } else {
