@@ -116,6 +116,60 @@ impl Cycles {
         self.bounds.iter().map(|(a, b)| (b - a) as f64).sum::<f64>() / self.bounds.len() as f64
     }
 
+    /// How freely the cycle's phase runs in `x`: each cycle's phase at the mean frequency
+    /// (`fundamental` over the cycle, referred to the record's start) is held against a straight
+    /// line (a fixed period), and the wander is the variance of what is left over half the variance
+    /// of its steps from cycle to cycle.
+    ///
+    /// An oscillation forced by an input of fixed period keeps time with it: its phases scatter
+    /// about the line independently, and the wander stays near 1 (under 2.6 in 999 of 1,000
+    /// records of white scatter, for 6 to 60 cycles). A self-sustained oscillation (a limit cycle,
+    /// or a resonance driven by noise) has no clock: each cycle's noise shifts all later ones, the
+    /// phase drifts as a random walk, and the wander grows with the cycles (median 3.5 over 30,
+    /// 7 over 60). `None` for fewer than 6 cycles.
+    pub fn phase_wander(&self, x: &[f64]) -> Option<f64> {
+        let m = self.bounds.len();
+        if m < 6 {
+            return None;
+        }
+        let theta = 2.0 * std::f64::consts::PI / self.period();
+        let mut phases: Vec<f64> = self
+            .bounds
+            .iter()
+            .map(|&(a, b)| fundamental(&x[a..b], theta).arg() - theta * a as f64)
+            .collect();
+        // unwrap: neighbouring cycles differ by far less than a turn
+        for k in 1..m {
+            let d = phases[k] - phases[k - 1];
+            phases[k] -= (d / std::f64::consts::TAU).round() * std::f64::consts::TAU;
+        }
+        // against the cycles' middles (a cycle left out leaves a gap in time, not in the count)
+        let mids: Vec<f64> = self
+            .bounds
+            .iter()
+            .map(|&(a, b)| 0.5 * (a + b) as f64)
+            .collect();
+        let n = m as f64;
+        let (tbar, pbar) = (mids.iter().sum::<f64>() / n, phases.iter().sum::<f64>() / n);
+        let (mut sxy, mut sxx) = (0.0, 0.0);
+        for (t, p) in mids.iter().zip(&phases) {
+            sxy += (t - tbar) * (p - pbar);
+            sxx += (t - tbar).powi(2);
+        }
+        let slope = sxy / sxx;
+        let residuals: Vec<f64> = mids
+            .iter()
+            .zip(&phases)
+            .map(|(t, p)| p - pbar - slope * (t - tbar))
+            .collect();
+        let var = residuals.iter().map(|r| r * r).sum::<f64>() / n;
+        let steps: Vec<f64> = residuals.windows(2).map(|w| w[1] - w[0]).collect();
+        let mean_step = steps.iter().sum::<f64>() / steps.len() as f64;
+        let step_var =
+            steps.iter().map(|s| (s - mean_step).powi(2)).sum::<f64>() / steps.len() as f64;
+        (step_var > 0.0).then(|| var / (0.5 * step_var))
+    }
+
     /// The complex amplitude of `x` in each cycle, at the cycle's own frequency, with that
     /// frequency.
     pub fn coefficients(&self, x: &[f64]) -> Vec<(f64, Complex64)> {
@@ -231,6 +285,34 @@ mod tests {
         let tenth: Vec<f64> = pv.iter().zip(&noise).map(|(a, b)| 0.1 * a + b).collect();
         let part = share_above_noise(&c.coefficients(&tenth), &cp, 0.5);
         assert!((0.05..0.15).contains(&part), "{part}");
+    }
+
+    #[test]
+    fn a_forced_cycle_keeps_time_and_a_free_one_drifts() {
+        let period = 40.0;
+        let wander = |x: &[f64]| Cycles::find(x, period).unwrap().phase_wander(x).unwrap();
+        for seed in 0..10 {
+            let mut rng = crate::rng::seeded(seed);
+            // a sine of fixed period under measurement noise: its crossings scatter, never drift
+            let forced: Vec<f64> = (0..2400)
+                .map(|k| {
+                    (2.0 * PI * k as f64 / period).sin() + 0.3 * crate::rng::gaussian(&mut rng)
+                })
+                .collect();
+            let w = wander(&forced);
+            assert!(w < 2.6, "seed {seed}: forced {w}");
+            // the same cycle with a phase that random-walks (a self-sustained oscillation under noise)
+            // (over 120 cycles: the wander of a random walk grows with the cycles counted)
+            let mut phase = 0.0;
+            let free: Vec<f64> = (0..4800)
+                .map(|k| {
+                    phase += 0.03 * crate::rng::gaussian(&mut rng);
+                    (2.0 * PI * k as f64 / period + phase).sin()
+                })
+                .collect();
+            let w = wander(&free);
+            assert!(w > 3.0, "seed {seed}: free {w}");
+        }
     }
 
     #[test]

@@ -170,3 +170,25 @@ fn where_the_fit_misses_short_sticks_the_describing_functions_band_is_reported()
         d.warnings
     );
 }
+
+#[test]
+fn issue_14s_example_is_called_sticky_by_the_cycle_that_sustains_itself() {
+    // tuned at 0.996 of its ultimate gain, the identified linear loop needs no valve lag to hold
+    // this cycle; what tells it from a marginal linear loop is the cycle: its amplitude holds
+    // while its phase runs free
+    let l = stiction_core::sim::catalogue::issue14_example();
+    let req = DiagnoseRequest {
+        ts: l.ts(),
+        ..DiagnoseRequest::default()
+    };
+    let d = diagnose(&record(&l.data), &req).unwrap();
+    let f = loop_family(&d);
+    assert_eq!(f.vote, Vote::Stiction, "{}", f.note);
+    assert!(f.note.contains("the cycle sustains itself"), "{}", f.note);
+    let e = f.limit_cycle.as_ref().unwrap();
+    assert!(e.needed_lag_degrees.abs() < 10.0, "{e:?}");
+    assert!(e.phase_wander.unwrap() > 3.0, "{e:?}");
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let band = d.band.as_ref().unwrap();
+    assert!((1.5..3.0).contains(&band.band_percent_of_span), "{band:?}");
+}

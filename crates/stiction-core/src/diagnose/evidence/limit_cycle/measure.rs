@@ -91,6 +91,7 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
     let controller_residual_share = share(&unexplained, &op_c);
     let amps: Vec<f64> = op_c.iter().map(|(_, z)| z.norm()).collect();
     let amplitude = AmplitudeTrend::of(&amps);
+    let phase_wander = cycles.phase_wander(op);
     let op_amplitude = amps.iter().sum::<f64>() / amps.len() as f64;
     let pv_amplitude = pv_c.iter().map(|(_, z)| z.norm()).sum::<f64>() / pv_c.len() as f64;
     let harmonic_count = measurable_harmonics(samples_per_cycle);
@@ -125,6 +126,7 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
         controller_residual_share,
         op_at_limit: at_limit(op, period / ts, ctx.req.op_range),
         amplitude,
+        phase_wander,
         needed_gain: needed.norm(),
         needed_lag_degrees: -needed.arg().to_degrees(),
         describing,

@@ -30,9 +30,9 @@
 //! look-alikes' stiction votes at or under 3 % per class; never on the ISDB.
 
 mod measure;
+mod vote;
 
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
-use crate::diagnose::result::Vote;
 use crate::loop_analysis::{AmplitudeTrend, Margins, PiFit};
 use crate::models::ModelKind;
 use serde::{Deserialize, Serialize};
@@ -84,6 +84,18 @@ pub const UNSTEADY_CHANGE: f64 = 0.5;
 /// The scatter of the cycle amplitudes (standard deviation of their logarithm) at which the
 /// amplitude is reported as unsteady.
 pub const UNSTEADY_SCATTER: f64 = 0.25;
+/// A cycle sustains itself when its amplitude scatters less than this from cycle to cycle
+/// (standard deviation of its logarithm), changes by less than [`UNSTEADY_CHANGE`] over the record,
+/// and its phase wanders more than [`FREE_RUNNING`]. Set on the plant benchmark's calibration
+/// sets: no look-alike there holds its amplitude this well while its phase runs free.
+pub const STEADY_SCATTER: f64 = 0.15;
+/// The phase wander (`loop_analysis::cycle::phase_wander`) above which the cycle keeps no outside
+/// clock: a cycle forced by an input of fixed period stays under 2.6 in 999 of 1,000 records of 6
+/// to 60 cycles.
+pub const FREE_RUNNING: f64 = 3.0;
+/// The strength of a stiction vote from a self-sustained cycle (with a setpoint recorded; without
+/// one the family does not vote on it: an outer loop's cycle moving the setpoint looks the same).
+pub const SELF_SUSTAINED: f64 = 0.6;
 /// A predicted period within this factor of the observed one matches it.
 pub const PERIOD_MATCH: f64 = 1.25;
 /// The harmonics are measured up to the 5th, or as many as lie below the Nyquist frequency; under
@@ -176,6 +188,11 @@ pub struct LoopEvidence {
     /// The amplitude of each cycle of OP.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub amplitude: Option<AmplitudeTrend>,
+    /// How freely the cycle's phase runs (`loop_analysis::cycle::phase_wander` of OP's cycles):
+    /// near 1 for a cycle that keeps time with an input of fixed period, growing with the cycles
+    /// for a self-sustained one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phase_wander: Option<f64>,
     /// What the valve must do for the identified loop to sustain the observed cycle: the
     /// describing function `N = -1 / L` at the cycle's frequency, as its gain and its phase lag
     /// (degrees). A linear loop at its stability limit needs nothing (gain 1, lag 0); a sticky
@@ -203,165 +220,19 @@ impl EvidenceFamily for LimitCycle {
         let threshold = format!(
             "stiction when the lag is {MIN_LAG} to {MAX_LAG} degrees and a sticky valve's describing function gives it (within {MAX_DISTANCE}), \
              the cycle has harmonics (at least {} of the fundamental's power, when the 3rd lies below the Nyquist frequency), OP explains all but {:.0} % of the PV's cycle, \
-             the identified loop's gain margin exceeds {MIN_MARGIN} and OP stays off its limits; none when OP reaches a limit of its range in the cycle \
-             (a loop that needs no valve, lag under {LINEAR_LAG} degrees, is left undetermined)",
+             the identified loop's gain margin exceeds {MIN_MARGIN} and OP stays off its limits; or, with a setpoint recorded, when the cycle sustains itself \
+             (its amplitude scatters under {:.0} % from cycle to cycle and changes under {:.0} % over the record while its phase wanders over {FREE_RUNNING}); \
+             none when OP reaches a limit of its range in the cycle (a loop that needs no valve, lag under {LINEAR_LAG} degrees, is otherwise left undetermined)",
             crate::diagnose::evidence::shape::SINUSOIDAL_HARMONICS,
             100.0 * MAX_RESIDUAL,
+            100.0 * STEADY_SCATTER,
+            100.0 * UNSTEADY_CHANGE,
         );
         match measure::measure(ctx) {
             Err(why) => FamilyEvidence::abstains(Family::Loop, statistic, threshold, why),
-            Ok(e) => vote(e, statistic, threshold),
+            Ok(e) => vote::vote(e, statistic, threshold),
         }
     }
-}
-
-fn vote(e: LoopEvidence, statistic: &str, threshold: String) -> FamilyEvidence {
-    let lag = e.needed_lag_degrees;
-    let gm = e.margins.gain_margin;
-    let (change, scatter) = e
-        .amplitude
-        .as_ref()
-        .map_or((0.0, 0.0), |a| (a.change, a.scatter));
-    // a cycle too short in samples to show harmonics is not taken for a sinusoid
-    let distorted = e
-        .harmonics
-        .is_none_or(|h| h >= crate::diagnose::evidence::shape::SINUSOIDAL_HARMONICS);
-    let dist = e.describing.as_ref().map_or(f64::INFINITY, |d| d.distance);
-    let facts = facts(&e);
-    let linear = lag.abs() < LINEAR_LAG && (e.needed_gain - 1.0).abs() < LINEAR_GAIN;
-    let valve_lag = (MIN_LAG..=MAX_LAG).contains(&lag) && dist <= MAX_DISTANCE;
-    let (vote, strength, why): (Vote, f64, String) = if e.op_at_limit >= LIMIT_CYCLES {
-        (
-            Vote::NoStiction,
-            0.6,
-            "OP reaches a limit of its range in the cycle: saturation bounds it".into(),
-        )
-    } else if e.controller_residual_share > MAX_CONTROLLER_RESIDUAL {
-        (
-            Vote::Undetermined,
-            0.0,
-            format!(
-                "the identified PI explains OP's cycle from the {} only to {:.0} %: a setpoint moving with an outer loop (a cascade) or a controller that is not a PI",
-                if e.setpoint_recorded { "recorded error" } else { "PV (no setpoint recorded)" },
-                100.0 * (1.0 - e.controller_residual_share).max(0.0)
-            ),
-        )
-    } else if valve_lag
-        && distorted
-        && e.residual_share <= MAX_RESIDUAL
-        && gm.is_none_or(|g| g > MIN_MARGIN)
-    {
-        let full = (0.6 + 0.4 * ((lag - MIN_LAG) / (FULL_LAG - MIN_LAG)).min(1.0)).min(1.0);
-        let s = if e.setpoint_recorded {
-            full
-        } else {
-            NO_SETPOINT * full
-        };
-        (
-            Vote::Stiction,
-            s,
-            format!(
-                "{}; a sticky valve's lag closes the balance{}",
-                match gm {
-                    Some(g) if g <= 1.0 => format!(
-                        "the identified linear loop is at or just past its stability limit (gain margin {g:.2}) and cannot sustain this cycle without a lag in the valve"
-                    ),
-                    _ => "the identified linear loop is stable and cannot sustain this cycle".into(),
-                },
-                if e.setpoint_recorded { "" } else { " (weakened: without a setpoint a cascade's moving setpoint cannot be ruled out)" }
-            ),
-        )
-    } else if linear {
-        let drifts = change.abs() >= UNSTEADY_CHANGE || scatter >= UNSTEADY_SCATTER;
-        (
-            Vote::Undetermined,
-            0.0,
-            format!(
-                "the identified linear loop sustains the cycle by itself (it is at its stability limit at this period{}): a marginal linear loop, \
-                 an external input the fit absorbed, or a valve band small beside the cycle; the loop alone cannot tell them apart",
-                if drifts { ", and the amplitude grows, decays or wanders as a linear loop's does" } else { "" }
-            ),
-        )
-    } else {
-        let mut missing = Vec::new();
-        if !valve_lag {
-            missing.push(format!("no sticky valve gives the needed describing function (lag {lag:.0}°, {dist:.2} away)"));
-        }
-        if !distorted {
-            missing.push("the cycle is sinusoidal where a valve's lag would distort it".into());
-        }
-        if e.residual_share > MAX_RESIDUAL {
-            missing.push(format!(
-                "{:.0} % of the PV's cycle is not explained by OP",
-                100.0 * e.residual_share
-            ));
-        }
-        if gm.is_some_and(|g| g <= MIN_MARGIN) {
-            missing.push(format!(
-                "the identified linear loop is unstable (gain margin under {MIN_MARGIN})"
-            ));
-        }
-        (Vote::Undetermined, 0.0, missing.join("; "))
-    };
-    FamilyEvidence {
-        family: Family::Loop,
-        vote,
-        strength,
-        value: Some(lag),
-        statistic: statistic.into(),
-        threshold,
-        note: format!("{why}; {facts}"),
-        model: None,
-        stick_slip: None,
-        valve: None,
-        limit_cycle: Some(e),
-    }
-}
-
-/// What the family measured, in words (the note's second half).
-fn facts(e: &LoopEvidence) -> String {
-    let harmonics_text = match e.harmonics {
-        Some(h) if e.harmonic_count < 5 => format!("harmonics {h:.3} (2 to {})", e.harmonic_count),
-        Some(h) => format!("harmonics {h:.3}"),
-        None => format!(
-            "harmonics not measured (a cycle of {:.1} samples puts the 3rd above the Nyquist frequency)",
-            e.samples_per_cycle
-        ),
-    };
-    let amplitude_text = e.amplitude.as_ref().map_or_else(
-        || "amplitude from cycle to cycle not measured".to_string(),
-        |a| {
-            format!(
-                "amplitude {:+.0} % over {} cycles, scatter {:.0} %",
-                100.0 * a.change,
-                a.cycles,
-                100.0 * a.scatter
-            )
-        },
-    );
-    format!(
-        "cycle of {:.0} s, OP amplitude {:.2}; the loop needs a valve gain {:.2} and lag {:.0}°{}; {harmonics_text}; \
-         {:.0} % of the PV's cycle unexplained by OP; {}; gain margin {}; PI Kc {:.3}, Ti {} (R² {:.2})",
-        e.period,
-        e.op_amplitude,
-        e.needed_gain,
-        e.needed_lag_degrees,
-        e.describing.as_ref().map_or(String::new(), |d| format!(
-            " ({} {:.2} % of span, {:.2} away)",
-            match d.model {
-                ModelKind::Stenman => "Stenman band".to_string(),
-                _ => format!("Kano S with J/S {:.2},", d.slip_ratio),
-            },
-            d.band_percent_of_span,
-            d.distance
-        )),
-        100.0 * e.residual_share,
-        amplitude_text,
-        e.margins.gain_margin.map_or("none (no crossing)".into(), |g| format!("{g:.2}")),
-        e.controller.kc,
-        e.controller.ti.map_or("-".into(), |t| format!("{t:.0} s")),
-        e.controller.r2
-    )
 }
 
 #[cfg(test)]

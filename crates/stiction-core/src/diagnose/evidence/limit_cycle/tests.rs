@@ -1,6 +1,6 @@
 //! The loop family's vote on fixed evidence.
 use super::*;
-use crate::diagnose::result::Verdict;
+use crate::diagnose::result::{Verdict, Vote};
 use crate::diagnose::verdict::decide;
 
 fn vote(family: Family, vote: Vote, strength: f64) -> FamilyEvidence {
@@ -43,7 +43,7 @@ fn judged(harmonics: Option<f64>, harmonic_count: usize) -> FamilyEvidence {
     let mut e: LoopEvidence = serde_json::from_str(SHORT_CYCLE).unwrap();
     e.harmonics = harmonics;
     e.harmonic_count = harmonic_count;
-    super::vote(e, "", String::new())
+    super::vote::vote(e, "", String::new())
 }
 
 #[test]
@@ -91,7 +91,7 @@ fn a_loop_just_past_its_limit_still_needs_the_valves_lag() {
         e.harmonics = Some(0.06);
         e.harmonic_count = 4;
         e.margins.gain_margin = Some(g);
-        super::vote(e, "", String::new())
+        super::vote::vote(e, "", String::new())
     };
     let near = with_margin(0.9);
     assert_eq!(near.vote, Vote::Stiction, "{}", near.note);
@@ -107,5 +107,59 @@ fn a_loop_just_past_its_limit_still_needs_the_valves_lag() {
         unstable.note.contains("unstable (gain margin under 0.8)"),
         "{}",
         unstable.note
+    );
+}
+
+/// The cycle of issue 14's example as the family measures it (Kc at 0.996 of the ultimate gain,
+/// a Stenman band of 2 %): the identified loop is at its limit and needs no valve lag.
+fn marginal(scatter: f64, change: f64, wander: f64, setpoint: bool) -> FamilyEvidence {
+    let mut e: LoopEvidence = serde_json::from_str(SHORT_CYCLE).unwrap();
+    e.needed_gain = 0.98;
+    e.needed_lag_degrees = 5.0;
+    e.margins.gain_margin = Some(1.0);
+    e.harmonics = Some(0.0);
+    e.harmonic_count = 5;
+    e.residual_share = 0.01;
+    e.setpoint_recorded = setpoint;
+    e.amplitude = Some(AmplitudeTrend {
+        cycles: 31,
+        mean: 10.0,
+        change,
+        scatter,
+    });
+    e.phase_wander = Some(wander);
+    super::vote::vote(e, "", String::new())
+}
+
+#[test]
+fn a_steady_cycle_whose_phase_runs_free_sustains_itself() {
+    let held = marginal(0.06, 0.12, 3.8, true);
+    assert_eq!(held.vote, Vote::Stiction, "{}", held.note);
+    assert_eq!(held.strength, SELF_SUSTAINED);
+    assert!(
+        held.note.contains("the cycle sustains itself") && held.note.contains("phase wander 3.8"),
+        "{}",
+        held.note
+    );
+    // a cycle that keeps time with an input of fixed period (an external sinusoid the fit absorbed)
+    let forced = marginal(0.02, 0.0, 1.1, true);
+    assert_eq!(forced.vote, Vote::Undetermined, "{}", forced.note);
+    assert!(
+        forced.note.contains("sustains the cycle by itself"),
+        "{}",
+        forced.note
+    );
+    // a resonance that noise swells and shrinks, or a cycle that grows
+    for (scatter, change) in [(0.4, 0.0), (0.05, 1.5)] {
+        let linear = marginal(scatter, change, 8.0, true);
+        assert_eq!(linear.vote, Vote::Undetermined, "{}", linear.note);
+    }
+    // without a setpoint an outer loop's cycle could move it: said, not voted
+    let blind = marginal(0.06, 0.12, 3.8, false);
+    assert_eq!(blind.vote, Vote::Undetermined, "{}", blind.note);
+    assert!(
+        blind.note.contains("sustains itself") && blind.note.contains("without a setpoint"),
+        "{}",
+        blind.note
     );
 }
