@@ -14,6 +14,7 @@
 use rand::RngExt;
 use rayon::prelude::*;
 use std::fmt::Write as _;
+use stiction_core::diagnose::evidence::limit_cycle::{LoopEvidence, StictionBasis};
 use stiction_core::diagnose::{
     diagnose, DiagnoseRequest, Diagnosis, Family, LoopRecord, Verdict, Vote,
 };
@@ -295,29 +296,53 @@ fn main() {
             fam(Vote::Undetermined)
         );
     }
-    // the describing-function band against the simulated one, where the family voted stiction
-    let mut ratios: Vec<f64> = results
-        .iter()
-        .filter(|r| r.0.sticky())
-        .filter_map(|r| {
-            let f = r.4.families.iter().find(|f| f.family == Family::Loop)?;
-            let b = f.limit_cycle.as_ref()?.describing.as_ref()?;
-            (f.vote == Vote::Stiction).then_some(b.band / r.3)
-        })
-        .collect();
-    ratios.sort_by(f64::total_cmp);
-    if !ratios.is_empty() {
-        let q = |p: f64| ratios[((ratios.len() - 1) as f64 * p).round() as usize];
-        let within = ratios.iter().filter(|r| (0.67..=1.5).contains(*r)).count();
-        let _ = writeln!(
-            md,
-            "\nDescribing-function band over the simulated band (Stenman d, Kano S, He fs), on the {} sticky loops the loop family called sticky: \
-             median {:.2}, quartiles {:.2} to {:.2}; {within} within a factor 1.5.",
-            ratios.len(),
-            q(0.5),
-            q(0.25),
-            q(0.75)
-        );
+    // the describing-function band and the band reported against the simulated one, where the
+    // family voted stiction, by what the vote rests on
+    for (basis, words) in [
+        (
+            StictionBasis::ValveLag,
+            "a sticky valve's lag closes the loop's balance",
+        ),
+        (StictionBasis::SelfSustained, "the cycle sustains itself"),
+    ] {
+        let of = |band: &dyn Fn(&Diagnosis, &LoopEvidence) -> Option<f64>| -> Vec<f64> {
+            let mut v: Vec<f64> = results
+                .iter()
+                .filter(|r| r.0.sticky())
+                .filter_map(|r| {
+                    let f = r.4.families.iter().find(|f| f.family == Family::Loop)?;
+                    let l = f.limit_cycle.as_ref()?;
+                    (f.vote == Vote::Stiction && l.stiction_basis == Some(basis))
+                        .then(|| band(&r.4, l))
+                        .flatten()
+                        .map(|b| b / r.3)
+                })
+                .collect();
+            v.sort_by(f64::total_cmp);
+            v
+        };
+        let describing = of(&|_, l| l.describing.as_ref().map(|b| b.band));
+        let reported = of(&|d, _| d.band.as_ref().map(|b| b.band_percent_of_span));
+        let summary = |v: &[f64]| -> String {
+            let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+            let within = v.iter().filter(|r| (0.67..=1.5).contains(*r)).count();
+            format!(
+                "median {:.2}, quartiles {:.2} to {:.2}, {within} of {} within a factor 1.5",
+                q(0.5),
+                q(0.25),
+                q(0.75),
+                v.len()
+            )
+        };
+        if !describing.is_empty() && !reported.is_empty() {
+            let _ = writeln!(
+                md,
+                "\nWhere the loop family called a sticky loop sticky because {words}, the band over the simulated band (Stenman d, Kano S, He fs): \
+                 the describing function's {}; the band the verdict reports {}.",
+                summary(&describing),
+                summary(&reported)
+            );
+        }
     }
     // why the family left sticky loops undetermined (a loop can have several reasons)
     let reasons = [

@@ -3,6 +3,7 @@
 //! with a period of about two minutes; through a healthy valve, the same loop with an external
 //! sinusoid at that period, or tuned to its stability limit, does not.
 
+use stiction_core::diagnose::evidence::limit_cycle::StictionBasis;
 use stiction_core::diagnose::{
     diagnose, BandSource, DiagnoseRequest, Diagnosis, Family, FamilyEvidence, LoopRecord, Verdict,
     Vote,
@@ -189,6 +190,17 @@ fn issue_14s_example_is_called_sticky_by_the_cycle_that_sustains_itself() {
     assert!(e.needed_lag_degrees.abs() < 10.0, "{e:?}");
     assert!(e.phase_wander.unwrap() > 3.0, "{e:?}");
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    // the describing function does not size a band from such a cycle: the closed-loop estimate
+    // is reported, with a note that it is rough
+    assert_eq!(e.stiction_basis, Some(StictionBasis::SelfSustained));
     let band = d.band.as_ref().unwrap();
+    assert_eq!(band.source, BandSource::ClosedLoop, "{band:?}");
     assert!((1.5..3.0).contains(&band.band_percent_of_span), "{band:?}");
+    assert!(
+        d.warnings
+            .iter()
+            .any(|w| w.contains("cycle that sustains itself")),
+        "{:?}",
+        d.warnings
+    );
 }

@@ -130,6 +130,7 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
         needed_gain: needed.norm(),
         needed_lag_degrees: -needed.arg().to_degrees(),
         describing,
+        stiction_basis: None,
         caveat,
         calibration: CALIBRATION.into(),
     })

@@ -124,6 +124,18 @@ pub enum ProcessSource {
     LinearFit,
 }
 
+/// What a stiction vote of the family rests on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StictionBasis {
+    /// A sticky valve's lag closes the harmonic balance of the identified loop: its describing
+    /// function's band fits the cycle.
+    ValveLag,
+    /// The cycle sustains itself (amplitude steady, phase free) while the identified loop needs
+    /// no valve lag: the describing function does not pin the band down.
+    SelfSustained,
+}
+
 /// The valve whose describing function closes the harmonic balance of the identified loop at the
 /// observed cycle, and the band that makes the observed amplitude.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -204,6 +216,9 @@ pub struct LoopEvidence {
     /// The valve and band that give it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub describing: Option<DescribingBand>,
+    /// What the family's stiction vote rests on (none without one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiction_basis: Option<StictionBasis>,
     /// Caveats (a missing setpoint, a cascade).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub caveat: Option<String>,

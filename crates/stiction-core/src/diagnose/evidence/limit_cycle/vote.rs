@@ -1,7 +1,7 @@
 //! The loop family's vote on what it measured, and its note in words.
 
 use super::{
-    LoopEvidence, FREE_RUNNING, FULL_LAG, LIMIT_CYCLES, LINEAR_GAIN, LINEAR_LAG,
+    LoopEvidence, StictionBasis, FREE_RUNNING, FULL_LAG, LIMIT_CYCLES, LINEAR_GAIN, LINEAR_LAG,
     MAX_CONTROLLER_RESIDUAL, MAX_DISTANCE, MAX_LAG, MAX_RESIDUAL, MIN_LAG, MIN_MARGIN, NO_SETPOINT,
     SELF_SUSTAINED, STEADY_SCATTER, UNSTEADY_CHANGE, UNSTEADY_SCATTER,
 };
@@ -12,8 +12,15 @@ use crate::models::ModelKind;
 /// A vote, its strength and why.
 type Ballot = (Vote, f64, String);
 
-pub(super) fn vote(e: LoopEvidence, statistic: &str, threshold: String) -> FamilyEvidence {
+pub(super) fn vote(mut e: LoopEvidence, statistic: &str, threshold: String) -> FamilyEvidence {
     let (vote, strength, why) = ballot(&e);
+    if vote == Vote::Stiction {
+        e.stiction_basis = Some(if valve_lag_holds(&e) {
+            StictionBasis::ValveLag
+        } else {
+            StictionBasis::SelfSustained
+        });
+    }
     FamilyEvidence {
         family: Family::Loop,
         vote,
