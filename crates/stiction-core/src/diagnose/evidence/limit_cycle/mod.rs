@@ -201,7 +201,7 @@ pub struct LoopEvidence {
     /// The amplitude of each cycle of OP.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub amplitude: Option<AmplitudeTrend>,
-    /// How freely the cycle's phase runs (`loop_analysis::cycle::phase_wander` of OP's cycles):
+    /// How freely the cycle's phase runs (`Cycles::phase_wander` of OP's cycles):
     /// near 1 for a cycle that keeps time with an input of fixed period, growing with the cycles
     /// for a self-sustained one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
