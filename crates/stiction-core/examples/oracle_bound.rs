@@ -38,7 +38,7 @@ use rayon::prelude::*;
 use std::fmt::Write as _;
 use stiction_core::models::{He, Kano, Model, Stenman};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, LoopClass, Suite, Truth};
-use stiction_core::sim::{ClosedLoop, Process, Signal, ValveLag};
+use stiction_core::sim::{ClosedLoop, Plan, Process, Signal, ValveLag};
 use study_args::StudyArgs;
 
 /// The full-rate run of a loop: every plant step from the start of the warm-up.
@@ -55,27 +55,20 @@ struct FullRun {
 }
 
 fn full_run(setup: &ClosedLoop) -> FullRun {
-    let h = setup.controller_period.unwrap_or(setup.ts);
-    let m = setup.substeps.unwrap_or(1).max(1);
-    let dt = h / m as f64;
-    let warm = (setup.warmup / dt).round() as usize;
-    let recorded: Vec<usize> = (0..setup.samples)
-        .map(|k| warm + ((k as f64 * setup.ts) / dt + 1e-9).floor() as usize)
-        .collect();
-    let steps = recorded.last().map_or(0, |&j| j + 1);
+    let plan = Plan::new(setup);
     let mut full = setup.clone();
-    full.ts = dt;
-    full.controller_period = Some(h);
-    full.samples = steps;
+    full.ts = plan.dt;
+    full.controller_period = Some(plan.h);
+    full.samples = plan.steps;
     full.warmup = 0.0;
     let data = full.run().expect("a catalogue loop runs");
     FullRun {
         op: data.op,
         pv: data.pv,
-        warm,
-        recorded,
-        dt,
-        m,
+        warm: plan.recorded.first().copied().unwrap_or(0),
+        recorded: plan.recorded,
+        dt: plan.dt,
+        m: plan.substeps,
     }
 }
 

@@ -20,6 +20,7 @@ pub use historian::{
 };
 pub use process::{Process, ProcessState};
 pub use signal::Signal;
+pub use stepping::Plan;
 pub use valve::{backlash, Characteristic, ValveLag};
 
 use crate::models::Model;

@@ -5,17 +5,24 @@ use super::closed_loop::{Cascade, ClosedLoop, Pi};
 use super::process::ProcessState;
 use crate::rng::{gaussian, seeded};
 
-/// The time grid: controller period, plant step, steps simulated, and the plant step read at each
-/// recording time.
-pub(super) struct Plan {
+/// The time grid of a closed-loop run: controller period, plant step, steps simulated, and the
+/// plant step read at each recording time (steps count from the warm-up's start).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    /// Controller period, seconds.
     pub h: f64,
+    /// Plant step, seconds.
     pub dt: f64,
+    /// Plant steps per controller execution.
     pub substeps: usize,
+    /// Plant steps simulated.
     pub steps: usize,
+    /// The plant step the historian reads at each recorded sample.
     pub recorded: Vec<usize>,
 }
 
 impl Plan {
+    /// The grid `cl` runs on.
     pub fn new(cl: &ClosedLoop) -> Self {
         let h = cl.controller_period.unwrap_or(cl.ts);
         let substeps = cl.substeps.unwrap_or(1).max(1);
