@@ -66,21 +66,7 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
     let theta = 2.0 * PI * ts / period;
     let op_c = cycles.coefficients(op);
     let pv_c = cycles.coefficients(pv);
-    let sim = &fits.pv_stiction;
-    let residual: Vec<f64> = if sim.len() == ctx.pv.len() {
-        pv.iter().zip(&sim[s..e]).map(|(a, b)| a - b).collect()
-    } else {
-        pv.to_vec()
-    };
-    // PV's measurement noise in a cycle's fundamental is no unexplained input; the noise is
-    // estimated from PV's differences, which a cycle of few samples would swell, so only on
-    // cycles of at least NOISE_FREE_CYCLE samples
-    let residual_c = cycles.coefficients(&residual);
-    let residual_share = if samples_per_cycle >= NOISE_FREE_CYCLE {
-        share_above_noise(&residual_c, &pv_c, ctx.pv_noise)
-    } else {
-        share(&residual_c, &pv_c)
-    };
+    let residual_share = unexplained_share(ctx, &fits.pv_stiction, &cycles, &pv_c, [s, e]);
     // what the PI makes of the error's cycles, against OP's
     let unexplained: Vec<(f64, Complex64)> = cycles
         .coefficients(&ctx.error[s..e])
@@ -134,6 +120,32 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
         caveat,
         calibration: CALIBRATION.into(),
     })
+}
+
+/// The share of the PV's cycle (over `stretch`, whose cycles' coefficients are `pv_c`) that the
+/// stiction fit's simulated PV `sim` leaves unexplained. PV's measurement noise in a cycle's
+/// fundamental is no unexplained input; the noise is estimated from PV's differences, which a
+/// cycle of few samples would swell, so it is taken off only on cycles of at least
+/// [`NOISE_FREE_CYCLE`] samples.
+fn unexplained_share(
+    ctx: &Context,
+    sim: &[f64],
+    cycles: &Cycles,
+    pv_c: &[(f64, Complex64)],
+    [s, e]: [usize; 2],
+) -> f64 {
+    let pv = &ctx.pv[s..e];
+    let residual: Vec<f64> = if sim.len() == ctx.pv.len() {
+        pv.iter().zip(&sim[s..e]).map(|(a, b)| a - b).collect()
+    } else {
+        pv.to_vec()
+    };
+    let residual_c = cycles.coefficients(&residual);
+    if cycles.period() >= NOISE_FREE_CYCLE {
+        share_above_noise(&residual_c, pv_c, ctx.pv_noise)
+    } else {
+        share(&residual_c, pv_c)
+    }
 }
 
 /// How many harmonics (up to 5) of a cycle of `samples_per_cycle` samples lie, with their bands of
