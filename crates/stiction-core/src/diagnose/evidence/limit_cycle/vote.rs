@@ -9,18 +9,12 @@ use crate::diagnose::evidence::{Family, FamilyEvidence};
 use crate::diagnose::result::Vote;
 use crate::models::ModelKind;
 
-/// A vote, its strength and why.
-type Ballot = (Vote, f64, String);
+/// A vote, its strength, why, and what a stiction vote rests on.
+type Ballot = (Vote, f64, String, Option<StictionBasis>);
 
 pub(super) fn vote(mut e: LoopEvidence, statistic: &str, threshold: String) -> FamilyEvidence {
-    let (vote, strength, why) = ballot(&e);
-    if vote == Vote::Stiction {
-        e.stiction_basis = Some(if valve_lag_holds(&e) {
-            StictionBasis::ValveLag
-        } else {
-            StictionBasis::SelfSustained
-        });
-    }
+    let (vote, strength, why, basis) = ballot(&e);
+    e.stiction_basis = basis;
     FamilyEvidence {
         family: Family::Loop,
         vote,
@@ -65,6 +59,7 @@ fn ballot(e: &LoopEvidence) -> Ballot {
             Vote::NoStiction,
             0.6,
             "OP reaches a limit of its range in the cycle: saturation bounds it".into(),
+            None,
         );
     }
     if e.controller_residual_share > MAX_CONTROLLER_RESIDUAL {
@@ -76,6 +71,7 @@ fn ballot(e: &LoopEvidence) -> Ballot {
                 if e.setpoint_recorded { "recorded error" } else { "PV (no setpoint recorded)" },
                 100.0 * (1.0 - e.controller_residual_share).max(0.0)
             ),
+            None,
         );
     }
     if valve_lag_holds(e) {
@@ -98,9 +94,10 @@ fn ballot(e: &LoopEvidence) -> Ballot {
                  an external input the fit absorbed, or a valve band small beside the cycle; the loop alone cannot tell them apart",
                 if drifts { ", and the amplitude grows, decays or wanders as a linear loop's does" } else { "" }
             ),
+            None,
         );
     }
-    (Vote::Undetermined, 0.0, missing(e))
+    (Vote::Undetermined, 0.0, missing(e), None)
 }
 
 /// The valve's lag closes the balance: stiction, stronger the larger the lag.
@@ -122,7 +119,7 @@ fn valve_lag_ballot(e: &LoopEvidence) -> Ballot {
         },
         if e.setpoint_recorded { "" } else { " (weakened: without a setpoint a cascade's moving setpoint cannot be ruled out)" }
     );
-    (Vote::Stiction, strength, why)
+    (Vote::Stiction, strength, why, Some(StictionBasis::ValveLag))
 }
 
 /// The phase wander of a cycle that sustains itself: amplitude steady, phase free, OP explaining
@@ -153,12 +150,14 @@ fn self_sustained_ballot(e: &LoopEvidence, wander: f64) -> Ballot {
             Vote::Stiction,
             SELF_SUSTAINED,
             format!("{why}, so a non-linearity keeps it, and with OP off its limits that is the valve (a sticky valve, or a dead band)"),
+            Some(StictionBasis::SelfSustained),
         )
     } else {
         (
             Vote::Undetermined,
             0.0,
             format!("{why}; but without a setpoint a cascade's setpoint moving with an outer loop's cycle looks the same, so this is no vote"),
+            None,
         )
     }
 }
