@@ -83,7 +83,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         indices: Default::default(),
     };
     let families: Vec<FamilyEvidence> = evidence::all().iter().map(|f| f.evaluate(&ctx)).collect();
-    let decision = verdict::decide(&families, ctx.oscillation.oscillating);
+    let decision = verdict::decide(&families, &verdict::Motion::of(&ctx.oscillation, req.ts));
     let Context {
         oscillation,
         indices,

@@ -98,9 +98,47 @@ fn by_valve(families: &[FamilyEvidence]) -> Option<(Verdict, f64)> {
     Some((verdict, 0.8 + 0.2 * share))
 }
 
-/// Decide from the families' votes (`oscillating`: the loop oscillates, so a record no family
-/// could judge is not short of excitation).
-pub(super) fn decide(families: &[FamilyEvidence], oscillating: bool) -> Decision {
+/// What the oscillation tells a verdict that no family could judge.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Motion {
+    /// The loop oscillates, so a record no family could judge is not short of excitation.
+    pub oscillating: bool,
+    /// A regular cycle too short in samples for any family (its period, s, and samples per
+    /// period): the control error's autocorrelation shows it, but at a few samples a cycle it
+    /// passes for measurement noise.
+    pub unresolved_cycle: Option<(f64, f64)>,
+}
+
+/// Thornhill's regularity from which a cycle of under [`UNRESOLVED_SAMPLES`] samples a period is
+/// named in an `insufficient_data` reason. On the plant benchmark such cycles (regularity 5 to
+/// 40) are sticky valves' limit cycles recorded every 10 s and loops tuned at their stability
+/// limit, which the record is sampled too slowly to tell apart.
+const UNRESOLVED_REGULARITY: f64 = 5.0;
+/// A cycle of fewer samples than this a period is not resolved.
+const UNRESOLVED_SAMPLES: f64 = 4.0;
+
+impl Motion {
+    /// From the oscillation of the analysed stretch, sampled every `ts` seconds.
+    pub fn of(osc: &super::Oscillation, ts: f64) -> Self {
+        let r = &osc.regularity;
+        let unresolved_cycle = r
+            .period
+            .map(|p| (p, p / ts))
+            .filter(|&(_, samples)| samples < UNRESOLVED_SAMPLES)
+            .filter(|_| {
+                r.regularity >= UNRESOLVED_REGULARITY
+                    && r.regularity < crate::detect::REGULARITY_CAP
+            });
+        Self {
+            oscillating: osc.oscillating,
+            unresolved_cycle,
+        }
+    }
+}
+
+/// Decide from the families' votes and what the oscillation shows (`motion`).
+pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
+    let oscillating = motion.oscillating;
     let evidence = evidence_lines(families);
     let of =
         |v: Vote| -> Vec<&FamilyEvidence> { families.iter().filter(|f| f.vote == v).collect() };
@@ -110,7 +148,7 @@ pub(super) fn decide(families: &[FamilyEvidence], oscillating: bool) -> Decision
             verdict,
             confidence: Some(confidence),
             reason: None,
-            next_step: next_step(verdict, families),
+            next_step: next_step(verdict, families, motion),
             evidence,
         };
     }
@@ -133,10 +171,14 @@ pub(super) fn decide(families: &[FamilyEvidence], oscillating: bool) -> Decision
         (true, true) => (
             Verdict::InsufficientData,
             None,
-            Some(
-                "no family of evidence could judge this record: the loop is not excited enough (OP and PV hardly move above their noise, no oscillation)"
+            Some(match motion.unresolved_cycle {
+                Some((period, samples)) => format!(
+                    "no family of evidence could judge this record: the control error cycles regularly every {period:.0} s, only {samples:.1} samples a cycle, \
+                     which passes for measurement noise here; a sticky valve's cycle and a loop at its stability limit look alike at this sampling"
+                ),
+                None => "no family of evidence could judge this record: the loop is not excited enough (OP and PV hardly move above their noise, no oscillation)"
                     .to_string(),
-            ),
+            }),
         ),
         (false, true) if strongest(&pro) < DECIDES => (
             Verdict::Undetermined,
@@ -187,13 +229,13 @@ pub(super) fn decide(families: &[FamilyEvidence], oscillating: bool) -> Decision
         verdict,
         confidence,
         reason,
-        next_step: next_step(verdict, families),
+        next_step: next_step(verdict, families, motion),
         evidence,
     }
 }
 
 /// One line: what to do next.
-fn next_step(verdict: Verdict, families: &[FamilyEvidence]) -> String {
+fn next_step(verdict: Verdict, families: &[FamilyEvidence], motion: &Motion) -> String {
     let voted = |fam: Family, v: Vote| families.iter().any(|f| f.family == fam && f.vote == v);
     let op_does_not_drive = families.iter().any(|f| {
         f.family == Family::Model
@@ -223,8 +265,12 @@ fn next_step(verdict: Verdict, families: &[FamilyEvidence]) -> String {
         Verdict::Undetermined => {
             "record the valve position (MV) or run a valve travel test to settle it".into()
         }
-        Verdict::InsufficientData => {
-            "use a longer record in automatic with the loop excited (setpoint changes or disturbances)".into()
-        }
+        Verdict::InsufficientData => match motion.unresolved_cycle {
+            Some((period, _)) => format!(
+                "record the loop at least ten samples a cycle (every {:.1} s or faster) and judge it again",
+                period / 10.0
+            ),
+            None => "use a longer record in automatic with the loop excited (setpoint changes or disturbances)".into(),
+        },
     }
 }

@@ -276,3 +276,42 @@ fn an_oscillation_that_op_does_not_drive_is_not_stiction() {
     );
     assert!(d.band.is_none());
 }
+
+#[test]
+fn a_cycle_of_a_few_samples_is_named_not_called_unexcited() {
+    // routine-b-0011 of the plant benchmark: a flow loop recorded every 10 s whose sticky valve
+    // (Stenman d = 1.79 %) limit-cycles every 36 s; at 3.6 samples a cycle the cycle passes for
+    // measurement noise, and no family can judge it
+    let l = stiction_core::sim::catalogue::find("routine-b-0011").unwrap();
+    let req = DiagnoseRequest {
+        ts: l.ts(),
+        ..DiagnoseRequest::default()
+    };
+    let d = diagnose(&record(&l.data), &req).unwrap();
+    assert_eq!(d.verdict, Verdict::InsufficientData, "{:?}", d.evidence);
+    let reason = d.reason.unwrap();
+    assert!(
+        reason.contains("cycles regularly every") && reason.contains("samples a cycle"),
+        "{reason}"
+    );
+    assert!(
+        d.next_step.contains("ten samples a cycle"),
+        "{}",
+        d.next_step
+    );
+    // a loop that is merely quiet keeps the usual reason (routine-b-0274: a healthy temperature
+    // loop at a constant setpoint, its PV hardly moving above the noise)
+    let l = stiction_core::sim::catalogue::find("routine-b-0274").unwrap();
+    let req = DiagnoseRequest {
+        ts: l.ts(),
+        ..DiagnoseRequest::default()
+    };
+    let q = diagnose(&record(&l.data), &req).unwrap();
+    assert_eq!(q.verdict, Verdict::InsufficientData, "{:?}", q.evidence);
+    assert!(
+        q.reason.as_deref().unwrap().contains("not excited enough"),
+        "{:?}",
+        q.reason
+    );
+    assert!(q.next_step.contains("longer record"), "{}", q.next_step);
+}

@@ -1,13 +1,20 @@
 //! The loop family's vote on fixed evidence.
 use super::*;
 use crate::diagnose::result::{Verdict, Vote};
-use crate::diagnose::verdict::decide;
+use crate::diagnose::verdict::{decide, Motion};
 
 fn vote(family: Family, vote: Vote, strength: f64) -> FamilyEvidence {
     let mut f = FamilyEvidence::abstains(family, "", String::new(), String::new());
     f.vote = vote;
     f.strength = strength;
     f
+}
+
+fn oscillating() -> Motion {
+    Motion {
+        oscillating: true,
+        unresolved_cycle: None,
+    }
 }
 
 #[test]
@@ -20,11 +27,11 @@ fn shape_and_fit_votes_against_do_not_outweigh_the_loop() {
     ];
     let mut all = against.to_vec();
     all.push(vote(Family::Loop, Vote::Stiction, 0.9));
-    assert_eq!(decide(&all, true).verdict, Verdict::Stiction);
+    assert_eq!(decide(&all, &oscillating()).verdict, Verdict::Stiction);
     // weak loop evidence (no setpoint): never a confident no, the conflict is named
     let mut weak = against[..1].to_vec();
     weak.push(vote(Family::Loop, Vote::Stiction, 0.36));
-    let d = decide(&weak, true);
+    let d = decide(&weak, &oscillating());
     assert_eq!(d.verdict, Verdict::Undetermined);
     let reason = d.reason.unwrap();
     assert!(
@@ -32,7 +39,10 @@ fn shape_and_fit_votes_against_do_not_outweigh_the_loop() {
         "{reason}"
     );
     // without the loop family the same votes against decide
-    assert_eq!(decide(&against, true).verdict, Verdict::NoStiction);
+    assert_eq!(
+        decide(&against, &oscillating()).verdict,
+        Verdict::NoStiction
+    );
 }
 
 /// A fast loop's cycle (fast-c-0004 of the plant benchmark: Stenman band 4.65 %, sampled every
