@@ -277,17 +277,24 @@ fn an_oscillation_that_op_does_not_drive_is_not_stiction() {
     assert!(d.band.is_none());
 }
 
+/// A catalogue loop judged as `plant_benchmark` judges it (its sampling time and process type,
+/// the defaults otherwise).
+pub(crate) fn judge_catalogue(id: &str) -> stiction_core::diagnose::Diagnosis {
+    let l = stiction_core::sim::catalogue::find(id).unwrap();
+    let req = DiagnoseRequest {
+        ts: l.ts(),
+        integrating: l.integrating,
+        ..DiagnoseRequest::default()
+    };
+    diagnose(&record(&l.data), &req).unwrap()
+}
+
 #[test]
 fn a_cycle_of_a_few_samples_is_named_not_called_unexcited() {
     // routine-b-0011 of the plant benchmark: a flow loop recorded every 10 s whose sticky valve
     // (Stenman d = 1.79 %) limit-cycles every 36 s; at 3.6 samples a cycle the cycle passes for
     // measurement noise, and no family can judge it
-    let l = stiction_core::sim::catalogue::find("routine-b-0011").unwrap();
-    let req = DiagnoseRequest {
-        ts: l.ts(),
-        ..DiagnoseRequest::default()
-    };
-    let d = diagnose(&record(&l.data), &req).unwrap();
+    let d = judge_catalogue("routine-b-0011");
     assert_eq!(d.verdict, Verdict::InsufficientData, "{:?}", d.evidence);
     let reason = d.reason.unwrap();
     assert!(
@@ -301,12 +308,7 @@ fn a_cycle_of_a_few_samples_is_named_not_called_unexcited() {
     );
     // a loop that is merely quiet keeps the usual reason (routine-b-0274: a healthy temperature
     // loop at a constant setpoint, its PV hardly moving above the noise)
-    let l = stiction_core::sim::catalogue::find("routine-b-0274").unwrap();
-    let req = DiagnoseRequest {
-        ts: l.ts(),
-        ..DiagnoseRequest::default()
-    };
-    let q = diagnose(&record(&l.data), &req).unwrap();
+    let q = judge_catalogue("routine-b-0274");
     assert_eq!(q.verdict, Verdict::InsufficientData, "{:?}", q.evidence);
     assert!(
         q.reason.as_deref().unwrap().contains("not excited enough"),

@@ -143,12 +143,7 @@ fn where_the_fit_misses_short_sticks_the_describing_functions_band_is_reported()
     // fast-c-0004 of the plant benchmark: a flow loop sampled every 5 s under a controller
     // running every 3 s, a valve lag of 1.2 s, a Stenman band of 4.65 %. The closed-loop estimate
     // reads its short sticks as a band of 1.8 %; the describing function gives 3.6 %.
-    let l = stiction_core::sim::catalogue::find("fast-c-0004").unwrap();
-    let req = DiagnoseRequest {
-        ts: l.ts(),
-        ..DiagnoseRequest::default()
-    };
-    let d = diagnose(&record(&l.data), &req).unwrap();
+    let d = crate::diagnose::judge_catalogue("fast-c-0004");
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
     let band = d.band.as_ref().unwrap();
     assert_eq!(band.source, BandSource::DescribingFunction, "{band:?}");
@@ -177,12 +172,7 @@ fn issue_14s_example_is_called_sticky_by_the_cycle_that_sustains_itself() {
     // tuned at 0.996 of its ultimate gain, the identified linear loop needs no valve lag to hold
     // this cycle; what tells it from a marginal linear loop is the cycle: its amplitude holds
     // while its phase runs free
-    let l = stiction_core::sim::catalogue::issue14_example();
-    let req = DiagnoseRequest {
-        ts: l.ts(),
-        ..DiagnoseRequest::default()
-    };
-    let d = diagnose(&record(&l.data), &req).unwrap();
+    let d = crate::diagnose::judge_catalogue("issue14");
     let f = loop_family(&d);
     assert_eq!(f.vote, Vote::Stiction, "{}", f.note);
     assert!(f.note.contains("the cycle sustains itself"), "{}", f.note);
