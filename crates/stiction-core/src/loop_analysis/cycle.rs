@@ -53,20 +53,9 @@ impl AmplitudeTrend {
         }
         let logs: Vec<f64> = amps.iter().map(|a| a.ln()).collect();
         let m = logs.len() as f64;
-        let kbar = (m - 1.0) / 2.0;
-        let lbar = logs.iter().sum::<f64>() / m;
-        let (mut sxy, mut sxx) = (0.0, 0.0);
-        for (k, l) in logs.iter().enumerate() {
-            sxy += (k as f64 - kbar) * (l - lbar);
-            sxx += (k as f64 - kbar).powi(2);
-        }
-        let slope = sxy / sxx;
-        let var = logs
-            .iter()
-            .enumerate()
-            .map(|(k, l)| (l - lbar - slope * (k as f64 - kbar)).powi(2))
-            .sum::<f64>()
-            / (m - 2.0);
+        let index: Vec<f64> = (0..logs.len()).map(|k| k as f64).collect();
+        let (slope, residuals) = straight_line(&index, &logs);
+        let var = residuals.iter().map(|r| r * r).sum::<f64>() / (m - 2.0);
         Some(Self {
             cycles: amps.len(),
             mean: amps.iter().sum::<f64>() / m,
@@ -74,6 +63,24 @@ impl AmplitudeTrend {
             scatter: var.sqrt(),
         })
     }
+}
+
+/// The least-squares straight line through `(t, y)`: its slope, and what it leaves of `y`.
+fn straight_line(t: &[f64], y: &[f64]) -> (f64, Vec<f64>) {
+    let n = t.len() as f64;
+    let (tbar, ybar) = (t.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for (a, b) in t.iter().zip(y) {
+        sxy += (a - tbar) * (b - ybar);
+        sxx += (a - tbar).powi(2);
+    }
+    let slope = sxy / sxx;
+    let residuals = t
+        .iter()
+        .zip(y)
+        .map(|(a, b)| b - ybar - slope * (a - tbar))
+        .collect();
+    (slope, residuals)
 }
 
 /// The cycles of an oscillation, each from one upward zero crossing of the band-passed signal to
@@ -149,20 +156,8 @@ impl Cycles {
             .iter()
             .map(|&(a, b)| 0.5 * (a + b) as f64)
             .collect();
-        let n = m as f64;
-        let (tbar, pbar) = (mids.iter().sum::<f64>() / n, phases.iter().sum::<f64>() / n);
-        let (mut sxy, mut sxx) = (0.0, 0.0);
-        for (t, p) in mids.iter().zip(&phases) {
-            sxy += (t - tbar) * (p - pbar);
-            sxx += (t - tbar).powi(2);
-        }
-        let slope = sxy / sxx;
-        let residuals: Vec<f64> = mids
-            .iter()
-            .zip(&phases)
-            .map(|(t, p)| p - pbar - slope * (t - tbar))
-            .collect();
-        let var = residuals.iter().map(|r| r * r).sum::<f64>() / n;
+        let (_, residuals) = straight_line(&mids, &phases);
+        let var = residuals.iter().map(|r| r * r).sum::<f64>() / m as f64;
         let steps: Vec<f64> = residuals.windows(2).map(|w| w[1] - w[0]).collect();
         let mean_step = steps.iter().sum::<f64>() / steps.len() as f64;
         let step_var =
