@@ -18,6 +18,8 @@
 //! optimum before they are compared.
 
 mod band;
+mod dependence;
+pub use dependence::correlation_span;
 
 use super::problem::{difference, range};
 use crate::detect::measurement_noise;
@@ -110,6 +112,11 @@ pub struct FitComparison {
     pub stiction_model: Option<Fit>,
     /// The mean OP subtracted from the valve position before fitting levels.
     pub op_offset: f64,
+    /// The samples one independent change spans in the test of the two fits: the long-run
+    /// overlap of the stiction fit's residual with the change the band makes to the fit
+    /// (autocorrelations multiplied, Bartlett-weighted over four lags); about the lag for noise,
+    /// many more where residual and band share a cycle OP does not drive.
+    pub correlation_span: f64,
 }
 
 /// Bands (shares of the OP range) at which the linear structure is chosen again.
@@ -384,7 +391,22 @@ impl Fits {
         // the compared output's noise: white noise differenced over the lag (twice again for an
         // integrating structure's change)
         let sigma = measurement_noise(pv);
+        let compared = Data::new(&setup.y, setup.t0);
+        let mv_compared = {
+            let mut mv = vec![0.0; op.len() - setup.lag];
+            difference(&mv_stiction, setup.lag, &mut mv);
+            mv
+        };
+        let correlation_span = dependence::correlation_span(
+            &compared,
+            setup.lag,
+            (&mv_compared, &fit_s),
+            self.linear
+                .as_ref()
+                .map(|f| (setup.linear_mv.as_slice(), f)),
+        );
         FitComparison {
+            correlation_span,
             structure: fit_s.structure,
             lag: setup.lag,
             samples_used: self.samples_used,
