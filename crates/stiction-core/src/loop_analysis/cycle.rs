@@ -11,10 +11,24 @@ use serde::{Deserialize, Serialize};
 /// `x[k] ≈ m + Re(X e^{jθk})`, returned as `X` (its modulus is the amplitude, its argument the
 /// phase). Zero when the fit is singular (fewer than 3 samples, or θ a multiple of π).
 pub fn fundamental(x: &[f64], theta: f64) -> Complex64 {
+    fit_fundamental(
+        x.iter()
+            .enumerate()
+            .map(|(k, &v)| ((theta * k as f64).sin_cos(), v)),
+    )
+}
+
+/// As [`fundamental`], with `(sin θk, cos θk)` for `k = 0, 1, ...` taken from `trig` (at least as
+/// long as `x`): many signals at one frequency share one table, bit for bit the same result.
+pub fn fundamental_from_table(x: &[f64], trig: &[(f64, f64)]) -> Complex64 {
+    fit_fundamental(trig.iter().copied().zip(x.iter().copied()))
+}
+
+/// The least-squares fit of `v ≈ m + A cos + B sin` over `((sin, cos), v)` pairs, as `A - jB`.
+fn fit_fundamental(samples: impl Iterator<Item = ((f64, f64), f64)>) -> Complex64 {
     let mut g = [[0.0f64; 3]; 3];
     let mut h = [0.0f64; 3];
-    for (k, &v) in x.iter().enumerate() {
-        let (s, c) = (theta * k as f64).sin_cos();
+    for ((s, c), v) in samples {
         let r = [c, s, 1.0];
         for i in 0..3 {
             h[i] += r[i] * v;

@@ -19,7 +19,7 @@
 //!   sample, which no continuous-time formula captures).
 //! - [`harmonic_balance`]: the crossings of a loop's Nyquist curve with a valve's locus.
 
-use super::cycle::fundamental;
+use super::cycle::fundamental_from_table;
 use super::Complex64;
 use crate::models::{Model, ModelKind, Stenman};
 use serde::{Deserialize, Serialize};
@@ -62,25 +62,60 @@ const MEASURED_PERIODS: usize = 6;
 /// whole periods once it has settled, averaged over four phases φ of the samples when a period
 /// has fewer than 50 samples.
 pub fn sampled(model: &Model, a: f64, samples_per_period: f64) -> Complex64 {
-    let theta = 2.0 * PI / samples_per_period.max(2.0);
-    let n_settle = (SETTLE_PERIODS as f64 * samples_per_period).ceil() as usize;
-    let n = n_settle + (MEASURED_PERIODS as f64 * samples_per_period).round() as usize;
-    let mut op = vec![0.0; n];
-    let mut mv = vec![0.0; n];
-    let mut total = Complex64::new(0.0, 0.0);
-    // where the samples fall on the sinusoid matters only when a period has few of them
-    let phases = if samples_per_period < 50.0 { 4 } else { 1 };
-    for q in 0..phases {
-        let phi = q as f64 * theta / phases as f64;
-        for (k, u) in op.iter_mut().enumerate() {
-            *u = 50.0 + a * (theta * k as f64 + phi).cos();
+    Sinusoids::new(samples_per_period).describing(model, a)
+}
+
+/// The sinusoids a sampled describing function runs on, for one number of samples a period,
+/// computed once for every amplitude and valve (the results are bit for bit those of computing
+/// them each time).
+struct Sinusoids {
+    n_settle: usize,
+    /// For each phase φ of the samples, `cos(θ k + φ)` over the whole run.
+    cosines: Vec<Vec<f64>>,
+    /// `(sin θk, cos θk)` over the measured periods.
+    trig: Vec<(f64, f64)>,
+}
+
+impl Sinusoids {
+    fn new(samples_per_period: f64) -> Self {
+        let theta = 2.0 * PI / samples_per_period.max(2.0);
+        let n_settle = (SETTLE_PERIODS as f64 * samples_per_period).ceil() as usize;
+        let n = n_settle + (MEASURED_PERIODS as f64 * samples_per_period).round() as usize;
+        // where the samples fall on the sinusoid matters only when a period has few of them
+        let phases = if samples_per_period < 50.0 { 4 } else { 1 };
+        let cosines = (0..phases)
+            .map(|q| {
+                let phi = q as f64 * theta / phases as f64;
+                (0..n).map(|k| (theta * k as f64 + phi).cos()).collect()
+            })
+            .collect();
+        let trig = (0..n - n_settle.min(n))
+            .map(|k| (theta * k as f64).sin_cos())
+            .collect();
+        Self {
+            n_settle,
+            cosines,
+            trig,
         }
-        model.simulate_into(&op, &mut mv);
-        let x = fundamental(&mv[n_settle..], theta);
-        let u = fundamental(&op[n_settle..], theta);
-        total += x / u;
     }
-    total / phases as f64
+
+    /// The describing function of `model` at OP amplitude `a`, averaged over the phases.
+    fn describing(&self, model: &Model, a: f64) -> Complex64 {
+        let n = self.cosines[0].len();
+        let mut op = vec![0.0; n];
+        let mut mv = vec![0.0; n];
+        let mut total = Complex64::new(0.0, 0.0);
+        for cosine in &self.cosines {
+            for (u, c) in op.iter_mut().zip(cosine) {
+                *u = 50.0 + a * c;
+            }
+            model.simulate_into(&op, &mut mv);
+            let x = fundamental_from_table(&mv[self.n_settle..], &self.trig);
+            let u = fundamental_from_table(&op[self.n_settle..], &self.trig);
+            total += x / u;
+        }
+        total / self.cosines.len() as f64
+    }
 }
 
 /// Points of the amplitude-over-band grid of a locus, and its ends.
@@ -119,11 +154,12 @@ pub fn valve_loci(samples_per_period: f64) -> Vec<ValveLocus> {
         })
         .collect();
     let stenman = Model::Stenman(Stenman { d: 1.0 });
+    let sinusoids = Sinusoids::new(samples_per_period);
     out.push(ValveLocus {
         kind: ModelKind::Stenman,
         slip_ratio: 1.0,
         points: ratio_grid()
-            .map(|r| (r, sampled(&stenman, r, samples_per_period)))
+            .map(|r| (r, sinusoids.describing(&stenman, r)))
             .collect(),
     });
     out
@@ -221,6 +257,7 @@ fn segments(p0: Complex64, p1: Complex64, q0: Complex64, q1: Complex64) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::loop_analysis::cycle::fundamental;
     use crate::models::Kano;
 
     /// Gelb and Vander Velde's backlash of half-width b.
