@@ -273,10 +273,12 @@ pub fn unrecorded(x: &[f64]) -> Vec<bool> {
         return out;
     }
     let mut d1: Vec<f64> = x.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
-    d1.sort_by(f64::total_cmp);
+    // the median step, as a full sort would place it (selection: linear time)
+    let mid = d1.len() / 2;
+    let median = *d1.select_nth_unstable_by(mid, f64::total_cmp).1;
     let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     // rounding of the export (a few decimals) bends a straight line by far less than noise does
-    let tol = 0.01 * d1[d1.len() / 2] + 1e-12 * scale;
+    let tol = 0.01 * median + 1e-12 * scale;
     let straight = |k: usize| (x[k + 1] - 2.0 * x[k] + x[k - 1]).abs() <= tol;
     let mut k = 1;
     while k + 1 < n {
