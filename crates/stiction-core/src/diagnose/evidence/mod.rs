@@ -82,6 +82,11 @@ pub struct FamilyEvidence {
     pub threshold: String,
     /// Why it voted as it did, or why it could not vote.
     pub note: String,
+    /// For an `undetermined` vote: the side the statistic falls on when it was measured but lies
+    /// between the thresholds (evidence, too weak to decide); `None` when the family could not
+    /// judge the record or leans nowhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leans: Option<Vote>,
     /// The model family's details (on its evidence only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model: Option<ModelEvidence>,
@@ -107,6 +112,7 @@ impl FamilyEvidence {
             statistic: statistic.into(),
             threshold,
             note,
+            leans: None,
             model: None,
             stick_slip: None,
             valve: None,

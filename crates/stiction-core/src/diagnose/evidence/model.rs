@@ -193,6 +193,11 @@ impl EvidenceFamily for Model {
             evidence.kano_j
         );
         let (vote, strength, why) = vote(ctx, f, &levels);
+        // measured, between the thresholds: the fit gains more than most healthy loops give
+        let leans = (vote == Vote::Undetermined
+            && levels.significance > SIGNIFICANCE_NONE
+            && levels.significance < SIGNIFICANCE_STICTION)
+            .then_some(Vote::Stiction);
         FamilyEvidence {
             family: Family::Model,
             vote,
@@ -201,6 +206,7 @@ impl EvidenceFamily for Model {
             statistic: statistic.into(),
             threshold,
             note: format!("{why}; {fits}"),
+            leans,
             model: Some(evidence),
             stick_slip: None,
             valve: None,

@@ -100,6 +100,7 @@ impl EvidenceFamily for Shape {
                 osc.period.unwrap_or(0.0),
                 osc.regularity.regularity
             ),
+            leans: None,
             model: None,
             stick_slip: None,
             valve: None,

@@ -316,18 +316,33 @@ impl EvidenceFamily for StickSlip {
                     plural(e.quiet_stretches, "stretch", "stretches")
                 ),
             )
+        } else if e.episodes >= MIN_EPISODES {
+            (
+                Vote::Undetermined,
+                0.0,
+                format!(
+                    "{} episodes in {}, but they hold only {:.0} % of the OP's travel: a vote needs {:.0} %",
+                    e.episodes,
+                    plural(e.quiet_stretches, "quiet stretch", "quiet stretches"),
+                    100.0 * e.stuck_share,
+                    100.0 * MIN_STUCK_SHARE
+                ),
+            )
         } else {
             (
                 Vote::Undetermined,
                 0.0,
                 format!(
-                    "{} ({:.0} % of the OP's travel) in {}: too few to decide",
+                    "{} ({:.0} % of the OP's travel) in {}: too few to decide (a vote needs {MIN_EPISODES})",
                     plural(e.episodes, "episode", "episodes"),
                     100.0 * e.stuck_share,
                     plural(e.quiet_stretches, "quiet stretch", "quiet stretches")
                 ),
             )
         };
+        // enough episodes that hold too little of the OP's travel: evidence, too weak to decide
+        let leans =
+            (vote == Vote::Undetermined && e.episodes >= MIN_EPISODES).then_some(Vote::Stiction);
         let skipped = e.skipped_unrecorded + e.skipped_slow + e.skipped_direction;
         let note = if skipped > 0 {
             format!(
@@ -345,6 +360,7 @@ impl EvidenceFamily for StickSlip {
             statistic: statistic.into(),
             threshold,
             note,
+            leans,
             model: None,
             stick_slip: Some(e),
             valve: None,

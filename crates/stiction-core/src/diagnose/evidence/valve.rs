@@ -131,6 +131,7 @@ impl EvidenceFamily for Valve {
             statistic: statistic.into(),
             threshold,
             note: why,
+            leans: None,
             model: None,
             stick_slip: None,
             valve: Some(evidence),

@@ -23,6 +23,7 @@ pub(super) fn vote(mut e: LoopEvidence, statistic: &str, threshold: String) -> F
         statistic: statistic.into(),
         threshold,
         note: format!("{why}; {}", facts(&e)),
+        leans: None,
         model: None,
         stick_slip: None,
         valve: None,

@@ -159,7 +159,16 @@ pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
     let w = |f: &&FamilyEvidence| weight(f, loop_holds);
     let total = |fs: &[&FamilyEvidence]| fs.iter().map(w).sum::<f64>();
     let strongest = |fs: &[&FamilyEvidence]| fs.iter().map(w).fold(0.0, f64::max);
+    let leaning: Vec<&FamilyEvidence> = families
+        .iter()
+        .filter(|f| f.vote == Vote::Undetermined && f.leans.is_some())
+        .collect();
     let (verdict, confidence, reason) = match (pro.is_empty(), con.is_empty()) {
+        (true, true) if !leaning.is_empty() => (
+            Verdict::Undetermined,
+            None,
+            Some(leaning_reason(&leaning)),
+        ),
         (true, true) if oscillating => (
             Verdict::Undetermined,
             None,
@@ -234,6 +243,32 @@ pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
     }
 }
 
+/// Why a record whose families measured something but none voted is undetermined: which lean
+/// which way, between their thresholds (their notes say by how much).
+fn leaning_reason(leaning: &[&FamilyEvidence]) -> String {
+    let side = |v: Vote| -> Vec<&FamilyEvidence> {
+        leaning
+            .iter()
+            .copied()
+            .filter(|f| f.leans == Some(v))
+            .collect()
+    };
+    let mut parts = Vec::new();
+    for (v, words) in [
+        (Vote::Stiction, "towards stiction"),
+        (Vote::NoStiction, "against stiction"),
+    ] {
+        let fams = side(v);
+        if !fams.is_empty() {
+            parts.push(format!("{words} ({})", names(&fams)));
+        }
+    }
+    format!(
+        "the evidence leans {} but lies between the thresholds, and no family votes: too weak to decide",
+        parts.join(" and ")
+    )
+}
+
 /// One line: what to do next.
 fn next_step(verdict: Verdict, families: &[FamilyEvidence], motion: &Motion) -> String {
     let voted = |fam: Family, v: Vote| families.iter().any(|f| f.family == fam && f.vote == v);
@@ -274,3 +309,6 @@ fn next_step(verdict: Verdict, families: &[FamilyEvidence], motion: &Motion) -> 
         },
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,51 @@
+//! The verdict on fixed votes.
+use super::*;
+
+fn family(family: Family, vote: Vote, leans: Option<Vote>) -> FamilyEvidence {
+    let mut f = FamilyEvidence::abstains(family, "", String::new(), String::new());
+    f.vote = vote;
+    f.strength = if vote == Vote::Undetermined { 0.0 } else { 0.6 };
+    f.leans = leans;
+    f
+}
+
+fn calm() -> Motion {
+    Motion::default()
+}
+
+#[test]
+fn evidence_between_the_thresholds_is_undetermined_not_insufficient() {
+    let families = [
+        family(Family::Model, Vote::Undetermined, Some(Vote::Stiction)),
+        family(Family::StickSlip, Vote::Undetermined, Some(Vote::Stiction)),
+        family(Family::Shape, Vote::Undetermined, None),
+    ];
+    let d = decide(&families, &calm());
+    assert_eq!(d.verdict, Verdict::Undetermined);
+    let reason = d.reason.unwrap();
+    assert!(
+        reason.contains("towards stiction (closed-loop fit and stick-slip episodes)"),
+        "{reason}"
+    );
+    assert!(d.confidence.is_none());
+}
+
+#[test]
+fn nothing_measured_is_insufficient_data() {
+    let families = [
+        family(Family::Model, Vote::Undetermined, None),
+        family(Family::StickSlip, Vote::Undetermined, None),
+    ];
+    let d = decide(&families, &calm());
+    assert_eq!(d.verdict, Verdict::InsufficientData);
+    assert!(d.reason.unwrap().contains("not excited enough"));
+}
+
+#[test]
+fn a_vote_outranks_a_lean() {
+    let families = [
+        family(Family::Model, Vote::Undetermined, Some(Vote::Stiction)),
+        family(Family::StickSlip, Vote::NoStiction, None),
+    ];
+    assert_eq!(decide(&families, &calm()).verdict, Verdict::NoStiction);
+}
