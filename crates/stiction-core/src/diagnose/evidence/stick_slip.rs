@@ -226,6 +226,60 @@ fn judge(
     }
 }
 
+/// The family's vote on its episodes (over a record of `samples`), its strength and why.
+fn ballot(e: &StickSlipEvidence, samples: usize) -> (Vote, f64, String) {
+    if e.episodes >= MIN_EPISODES && e.stuck_share >= MIN_STUCK_SHARE {
+        (
+            Vote::Stiction,
+            // corroborating evidence only: on the calibration set, episodes alone called too
+            // many healthy loops that hold PV against a load sticky
+            STICTION_STRENGTH,
+            format!(
+                "{} episodes of OP travelling while PV stayed put, then PV jumped OP's way ({:.0} % of the OP's travel; median {:.2} % of span per stick)",
+                e.episodes,
+                100.0 * e.stuck_share,
+                e.median_travel_percent_of_span.unwrap_or(0.0)
+            ),
+        )
+    } else if e.episodes <= MAX_EPISODES_NONE
+        && e.quiet_stretches >= MIN_STRETCHES_NONE
+        && samples >= MIN_SAMPLES_NONE
+    {
+        (
+            Vote::NoStiction,
+            0.25,
+            format!(
+                "{} in {} of quiet PV: PV follows OP",
+                plural(e.episodes, "stick-slip episode", "stick-slip episodes"),
+                plural(e.quiet_stretches, "stretch", "stretches")
+            ),
+        )
+    } else if e.episodes >= MIN_EPISODES {
+        (
+            Vote::Undetermined,
+            0.0,
+            format!(
+                "{} episodes in {}, but they hold only {:.0} % of the OP's travel: a vote needs {:.0} %",
+                e.episodes,
+                plural(e.quiet_stretches, "quiet stretch", "quiet stretches"),
+                100.0 * e.stuck_share,
+                100.0 * MIN_STUCK_SHARE
+            ),
+        )
+    } else {
+        (
+            Vote::Undetermined,
+            0.0,
+            format!(
+                "{} ({:.0} % of the OP's travel) in {}: too few to decide (a vote needs {MIN_EPISODES})",
+                plural(e.episodes, "episode", "episodes"),
+                100.0 * e.stuck_share,
+                plural(e.quiet_stretches, "quiet stretch", "quiet stretches")
+            ),
+        )
+    }
+}
+
 impl EvidenceFamily for StickSlip {
     fn family(&self) -> Family {
         Family::StickSlip
@@ -288,58 +342,7 @@ impl EvidenceFamily for StickSlip {
             episodes(ctx.op, ctx.pv, &settings)
         };
         e.median_travel_percent_of_span = e.median_travel.map(|t| ctx.req.percent_of_span(t));
-        let (vote, strength, why) = if e.episodes >= MIN_EPISODES
-            && e.stuck_share >= MIN_STUCK_SHARE
-        {
-            (
-                Vote::Stiction,
-                // corroborating evidence only: on the calibration set, episodes alone called too
-                // many healthy loops that hold PV against a load sticky
-                STICTION_STRENGTH,
-                format!(
-                    "{} episodes of OP travelling while PV stayed put, then PV jumped OP's way ({:.0} % of the OP's travel; median {:.2} % of span per stick)",
-                    e.episodes,
-                    100.0 * e.stuck_share,
-                    e.median_travel_percent_of_span.unwrap_or(0.0)
-                ),
-            )
-        } else if e.episodes <= MAX_EPISODES_NONE
-            && e.quiet_stretches >= MIN_STRETCHES_NONE
-            && ctx.op.len() >= MIN_SAMPLES_NONE
-        {
-            (
-                Vote::NoStiction,
-                0.25,
-                format!(
-                    "{} in {} of quiet PV: PV follows OP",
-                    plural(e.episodes, "stick-slip episode", "stick-slip episodes"),
-                    plural(e.quiet_stretches, "stretch", "stretches")
-                ),
-            )
-        } else if e.episodes >= MIN_EPISODES {
-            (
-                Vote::Undetermined,
-                0.0,
-                format!(
-                    "{} episodes in {}, but they hold only {:.0} % of the OP's travel: a vote needs {:.0} %",
-                    e.episodes,
-                    plural(e.quiet_stretches, "quiet stretch", "quiet stretches"),
-                    100.0 * e.stuck_share,
-                    100.0 * MIN_STUCK_SHARE
-                ),
-            )
-        } else {
-            (
-                Vote::Undetermined,
-                0.0,
-                format!(
-                    "{} ({:.0} % of the OP's travel) in {}: too few to decide (a vote needs {MIN_EPISODES})",
-                    plural(e.episodes, "episode", "episodes"),
-                    100.0 * e.stuck_share,
-                    plural(e.quiet_stretches, "quiet stretch", "quiet stretches")
-                ),
-            )
-        };
+        let (vote, strength, why) = ballot(&e, ctx.op.len());
         // enough episodes that hold too little of the OP's travel: evidence, too weak to decide
         let leans =
             (vote == Vote::Undetermined && e.episodes >= MIN_EPISODES).then_some(Vote::Stiction);
