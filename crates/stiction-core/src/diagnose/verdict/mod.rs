@@ -2,6 +2,9 @@
 //! confidence; families that conflict give `undetermined`, naming the conflict. The valve family
 //! (the recorded valve position) outweighs the indirect ones. Against the loop family's evidence
 //! of a non-linearity, the shape, fit and stick-slip votes against stiction count only weakly.
+//! A family whose statistic lies between its thresholds casts no vote but says which way it
+//! leans: with no vote cast, such a record is `undetermined` (judged, too weak to decide), not
+//! `insufficient_data` (nothing could be judged).
 
 use super::evidence::{Family, FamilyEvidence};
 use super::result::{Verdict, Vote};

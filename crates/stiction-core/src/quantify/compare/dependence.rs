@@ -18,8 +18,9 @@ const WINDOW_LAGS: usize = 4;
 /// The samples one independent change spans (at least 1): `1 + 2 sum_k w_k r_e(k) r_g(k)` over
 /// `k = 1 ..= WINDOW_LAGS * lag`, `r_e` the autocorrelation of the stiction fit's residual,
 /// `r_g` that of the stiction fit's output less the linear loop's, `w_k` Bartlett's weights.
-/// `y`: the compared output; `mv_stiction` and `mv_linear`: the valve trajectories the two fits
-/// see (differenced as `y`); `None` for the linear loop when it could not be fitted.
+/// `data`: the compared output; the stiction fit with the valve trajectory it sees (differenced
+/// as the output), and the linear loop's fit with OP's (`None` when it could not be fitted: the
+/// direction is then the stiction fit's whole output).
 pub fn correlation_span(
     data: &Data,
     lag: usize,
