@@ -228,6 +228,14 @@ mod tests {
     use super::*;
     use std::f64::consts::PI;
 
+    /// `n` samples of a unit sine of `period` samples under white noise of standard deviation
+    /// `noise`, drawn from `rng`.
+    fn noisy_sine(n: usize, period: f64, noise: f64, rng: &mut crate::rng::Rng) -> Vec<f64> {
+        (0..n)
+            .map(|k| (2.0 * PI * k as f64 / period).sin() + noise * crate::rng::gaussian(rng))
+            .collect()
+    }
+
     #[test]
     fn the_fundamental_of_a_shifted_sinusoid() {
         let theta = 2.0 * PI / 37.3;
@@ -303,11 +311,7 @@ mod tests {
         for seed in 0..10 {
             let mut rng = crate::rng::seeded(seed);
             // a sine of fixed period under measurement noise: its crossings scatter, never drift
-            let forced: Vec<f64> = (0..2400)
-                .map(|k| {
-                    (2.0 * PI * k as f64 / period).sin() + 0.3 * crate::rng::gaussian(&mut rng)
-                })
-                .collect();
+            let forced = noisy_sine(2400, period, 0.3, &mut rng);
             let w = wander(&forced);
             assert!(w < 2.6, "seed {seed}: forced {w}");
             // the same cycle with a phase that random-walks (a self-sustained oscillation under noise)
@@ -334,11 +338,7 @@ mod tests {
             let period = 20.0 + (seed % 7) as f64 * 3.3;
             let cycles = 8 + (seed % 53) as usize;
             let noise = [0.1, 0.3, 0.6][(seed % 3) as usize];
-            let x: Vec<f64> = (0..(cycles as f64 * period) as usize)
-                .map(|k| {
-                    (2.0 * PI * k as f64 / period).sin() + noise * crate::rng::gaussian(&mut rng)
-                })
-                .collect();
+            let x = noisy_sine((cycles as f64 * period) as usize, period, noise, &mut rng);
             let Some(w) = Cycles::find(&x, period).and_then(|c| c.phase_wander(&x)) else {
                 continue;
             };
@@ -357,11 +357,7 @@ mod tests {
         let period = 8.8;
         for seed in 0..20 {
             let mut rng = crate::rng::seeded(seed);
-            let x: Vec<f64> = (0..2000)
-                .map(|k| {
-                    (2.0 * PI * k as f64 / period).sin() + 1.5 * crate::rng::gaussian(&mut rng)
-                })
-                .collect();
+            let x = noisy_sine(2000, period, 1.5, &mut rng);
             let c = Cycles::find(&x, period).unwrap();
             assert!(c.bounds.iter().all(|(a, b)| b - a >= 5), "{:?}", c.bounds);
             let amps: Vec<f64> = c.coefficients(&x).iter().map(|(_, z)| z.norm()).collect();
