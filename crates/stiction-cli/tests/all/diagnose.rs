@@ -211,6 +211,52 @@ fn saturated_and_constant_loops_are_insufficient_data() {
 }
 
 #[test]
+fn a_still_op_is_insufficient_data_and_op_off_its_span_is_said() {
+    let dir = tempfile::tempdir().unwrap();
+    // OP held mid-range while PV cycles: the controller did not act, whatever PV does
+    let mut text = String::from("t,op,pv\n");
+    for k in 0..1000 {
+        let pv = 50.0 + (k as f64 * 0.1).sin();
+        text.push_str(&format!("{k},50,{pv}\n"));
+    }
+    let p = dir.path().join("still.csv");
+    std::fs::write(&p, text).unwrap();
+    let v = json(&ok(&["diagnose", p.to_str().unwrap(), "--json"]));
+    assert_eq!(v["verdict"], "insufficient_data", "{v:#}");
+    assert!(
+        v["reason"].as_str().unwrap().contains("OP stays at 50"),
+        "{v:#}"
+    );
+    // OP in raw units (a flow setpoint of some thousands): bands in % of span need --op-range
+    let f = simulate(dir.path(), "loop.csv", "2", &[]);
+    let raw = std::fs::read_to_string(&f).unwrap();
+    let mut lines = raw.lines();
+    let header = lines.next().unwrap();
+    let op_col = header.split(',').position(|c| c == "op").unwrap();
+    let mut scaled = format!("{header}\n");
+    for line in lines {
+        let mut cells: Vec<String> = line.split(',').map(String::from).collect();
+        cells[op_col] = format!("{}", cells[op_col].parse::<f64>().unwrap() * 40.0);
+        scaled.push_str(&cells.join(","));
+        scaled.push('\n');
+    }
+    let p = dir.path().join("raw.csv");
+    std::fs::write(&p, scaled).unwrap();
+    let text = ok(&["diagnose", p.to_str().unwrap(), "--sp", "sp"]);
+    assert!(text.contains("outside the valve's span 0 to 100"), "{text}");
+    assert!(text.contains("--op-range"), "{text}");
+    let text = ok(&[
+        "diagnose",
+        p.to_str().unwrap(),
+        "--sp",
+        "sp",
+        "--op-range",
+        "0:4000",
+    ]);
+    assert!(!text.contains("outside the valve's span"), "{text}");
+}
+
+#[test]
 fn bad_input_is_one_clear_sentence() {
     let dir = tempfile::tempdir().unwrap();
     let f = simulate(dir.path(), "loop.csv", "2", &[]);

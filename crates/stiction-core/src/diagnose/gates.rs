@@ -157,3 +157,77 @@ fn left_out(x: &Excluded) -> String {
         parts.join(", ")
     }
 }
+
+/// OP beyond the valve's span by more than this share of it: the span is likely not OP's.
+const OUTSIDE_SPAN: f64 = 0.05;
+
+/// A warning when OP leaves the valve's span (`op_range`, by default 0 to 100 %) by more than
+/// [`OUTSIDE_SPAN`] of it: bands in % of span then mean nothing until `--op-range` says what OP
+/// a closed and a fully open valve have.
+pub(super) fn op_outside_span(op: &[f64], req: &DiagnoseRequest) -> Option<String> {
+    let (lo, hi) = op
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let [closed, open] = req.op_range;
+    let margin = OUTSIDE_SPAN * (open - closed);
+    // a few significant digits, in any magnitude
+    let short = |v: f64| {
+        if v != 0.0 && !(1e-3..1e6).contains(&v.abs()) {
+            format!("{v:.3e}")
+        } else {
+            format!("{v:.4}")
+        }
+    };
+    (lo < closed - margin || hi > open + margin).then(|| {
+        let (lo, hi) = (short(lo), short(hi));
+        format!(
+            "OP runs from {lo} to {hi}, outside the valve's span {closed} to {open}: bands in % of span assume OP is on that span; \
+             give --op-range LO:HI (the OP of a closed and of a fully open valve)"
+        )
+    })
+}
+
+/// Why a stretch in which OP never moves cannot be judged: the controller did not act on the
+/// valve, so nothing in it tells how the valve responds.
+pub(super) fn op_still(op: &[f64]) -> Option<String> {
+    let first = *op.first()?;
+    op.iter().all(|&v| v == first).then(|| {
+        format!(
+            "OP stays at {first} over the whole analysed stretch: the controller did not move the valve (manual mode, or OP not recorded), so the record says nothing about the valve"
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn op_off_its_span_is_named_and_op_on_it_is_not() {
+        let req = DiagnoseRequest::default();
+        assert!(op_outside_span(&[0.0, 50.0, 100.0], &req).is_none());
+        // a little beyond the ends (a controller's output limits of -2 and 102 %) is no warning
+        assert!(op_outside_span(&[-2.0, 102.0], &req).is_none());
+        let w = op_outside_span(&[1200.0, 3400.0], &req).unwrap();
+        assert!(
+            w.contains("1200.0000 to 3400.0000") && w.contains("--op-range"),
+            "{w}"
+        );
+        let w = op_outside_span(&[4.9e301, 5.1e301], &req).unwrap();
+        assert!(w.contains("4.900e301"), "{w}");
+        let on_its_span = DiagnoseRequest {
+            op_range: [1000.0, 4000.0],
+            ..DiagnoseRequest::default()
+        };
+        assert!(op_outside_span(&[1200.0, 3400.0], &on_its_span).is_none());
+    }
+
+    #[test]
+    fn an_op_that_never_moves_is_still() {
+        assert!(op_still(&[50.0; 10]).unwrap().contains("OP stays at 50"));
+        assert!(op_still(&[50.0, 50.0, 50.1]).is_none());
+        assert!(op_still(&[]).is_none());
+    }
+}

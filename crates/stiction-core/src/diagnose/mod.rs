@@ -142,6 +142,7 @@ pub fn diagnose_checked(
         .unwrap_or((0, 0));
     let quality = gates::findings(r, (s, e), stretches.len(), &excluded, req);
     let mut warnings = Vec::new();
+    warnings.extend(gates::op_outside_span(&r.op[s..e], req));
     if r.sp.is_none() {
         warnings.push(
             "no setpoint column: the control error is taken as the PV's deviation from its mean"
@@ -181,6 +182,13 @@ pub fn diagnose_checked(
         return Ok(d);
     }
     let sub = r.slice(s, e);
+    if let Some(reason) = gates::op_still(sub.op) {
+        d.evidence = vec![reason.clone()];
+        d.reason = Some(reason);
+        d.next_step = "use a record in automatic, with OP as the controller wrote it".into();
+        d.seconds = started.elapsed().as_secs_f64();
+        return Ok(d);
+    }
     let j = judge(&sub, req);
     d.verdict = j.decision.verdict;
     d.confidence = j.decision.confidence;

@@ -43,8 +43,14 @@ pub(super) fn judge_windows(
             period: None,
             votes: Vec::new(),
         };
-        if e - s >= req.min_samples {
-            let j = judge(&sub.slice(s, e), req);
+        let judged = sub.slice(s, e);
+        let still = super::gates::op_still(judged.op);
+        if e - s < req.min_samples {
+            // too short: the reason above
+        } else if let Some(reason) = still {
+            v.reason = Some(reason);
+        } else {
+            let j = judge(&judged, req);
             v.verdict = j.decision.verdict;
             v.confidence = j.decision.confidence;
             v.reason = j.decision.reason;

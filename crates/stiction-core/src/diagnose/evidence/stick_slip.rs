@@ -183,7 +183,8 @@ fn judge(
         }
         retrace = retrace.max((extreme - v) * dir);
     }
-    if net.abs() < OP_TRAVEL_SIGMAS * s.op_noise || retrace > 0.5 * net.abs() + 2.0 * s.op_noise {
+    // (strictly beyond: OP that does not move at all is no travel, even without noise)
+    if net.abs() <= OP_TRAVEL_SIGMAS * s.op_noise || retrace > 0.5 * net.abs() + 2.0 * s.op_noise {
         return Episode::NoTravel;
     }
     let unrecorded = s.unrecorded[i..j].iter().filter(|&&u| u).count();
