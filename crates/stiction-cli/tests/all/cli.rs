@@ -615,6 +615,14 @@ fn quantify_bad_input_and_insufficient_data() {
     let c = write(dir.path(), "sat.csv", &text);
     let v = json(&ok(&["quantify", &c, "--json"]));
     assert_eq!(v["status"], "insufficient_data");
+    // OP in raw units, never inside 0-100 %: said, with the way out
+    let mut text = String::from("t,op,pv\n");
+    for k in 0..500 {
+        let u = (k as f64 * 0.1).sin();
+        text.push_str(&format!("{k},{},{}\n", 3000.0 + 500.0 * u, 20.0 + u));
+    }
+    let c = write(dir.path(), "raw.csv", &text);
+    fails(&["quantify", &c], &["raw.csv", "other units than %", "rescale"]);
 }
 
 #[test]

@@ -135,7 +135,9 @@ fn gates<'a>(
             "PV is constant at {pv_lo}: nothing responds to the valve"
         ))
     } else if op.iter().all(|&v| v <= 0.0 || v >= 100.0) {
-        Some("OP is saturated (at or beyond 0 or 100 %) the whole time".into())
+        Some(format!(
+            "OP is at or beyond 0 or 100 % the whole time (it runs from {op_lo} to {op_hi}): saturated, or recorded in other units than % (rescale it to 0-100 % of the valve's span)"
+        ))
     } else {
         None
     };
