@@ -622,7 +622,10 @@ fn quantify_bad_input_and_insufficient_data() {
         text.push_str(&format!("{k},{},{}\n", 3000.0 + 500.0 * u, 20.0 + u));
     }
     let c = write(dir.path(), "raw.csv", &text);
-    fails(&["quantify", &c], &["raw.csv", "other units than %", "rescale"]);
+    fails(
+        &["quantify", &c],
+        &["raw.csv", "other units than %", "rescale"],
+    );
 }
 
 #[test]

@@ -189,13 +189,25 @@ pub(super) fn op_outside_span(op: &[f64], req: &DiagnoseRequest) -> Option<Strin
     })
 }
 
-/// Why a stretch in which OP never moves cannot be judged: the controller did not act on the
-/// valve, so nothing in it tells how the valve responds.
-pub(super) fn op_still(op: &[f64]) -> Option<String> {
-    let first = *op.first()?;
-    op.iter().all(|&v| v == first).then(|| {
-        format!(
-            "OP stays at {first} over the whole analysed stretch: the controller did not move the valve (manual mode, or OP not recorded), so the record says nothing about the valve"
+/// Why a stretch in which OP or PV never moves cannot be judged, and what to do: with OP still
+/// the controller did not act on the valve; with PV still nothing shows the loop's response (a
+/// frozen transmitter, or PV not recorded).
+pub(super) fn still(op: &[f64], pv: &[f64]) -> Option<(String, String)> {
+    let constant = |x: &[f64]| x.first().filter(|&&v| x.iter().all(|&u| u == v)).copied();
+    if let Some(v) = constant(op) {
+        return Some((
+            format!(
+                "OP stays at {v} over the whole analysed stretch: the controller did not move the valve (manual mode, or OP not recorded), so the record says nothing about the valve"
+            ),
+            "use a record in automatic, with OP as the controller wrote it".into(),
+        ));
+    }
+    constant(pv).map(|v| {
+        (
+            format!(
+                "PV stays at {v} over the whole analysed stretch while OP moves: a frozen transmitter or a PV not recorded, so nothing shows how the loop responds to the valve"
+            ),
+            "check the PV transmitter and its historian tag, then judge a record in which PV moves".into(),
         )
     })
 }
@@ -225,9 +237,12 @@ mod tests {
     }
 
     #[test]
-    fn an_op_that_never_moves_is_still() {
-        assert!(op_still(&[50.0; 10]).unwrap().contains("OP stays at 50"));
-        assert!(op_still(&[50.0, 50.0, 50.1]).is_none());
-        assert!(op_still(&[]).is_none());
+    fn an_op_or_pv_that_never_moves_is_still() {
+        let moving = [50.0, 50.0, 50.1];
+        let why = |op: &[f64], pv: &[f64]| still(op, pv).map(|(reason, _)| reason);
+        assert!(why(&[50.0; 3], &moving).unwrap().contains("OP stays at 50"));
+        assert!(why(&moving, &[7.0; 3]).unwrap().contains("PV stays at 7"));
+        assert!(why(&moving, &moving).is_none());
+        assert!(why(&[], &[]).is_none());
     }
 }

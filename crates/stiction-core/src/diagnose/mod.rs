@@ -182,10 +182,10 @@ pub fn diagnose_checked(
         return Ok(d);
     }
     let sub = r.slice(s, e);
-    if let Some(reason) = gates::op_still(sub.op) {
+    if let Some((reason, next_step)) = gates::still(sub.op, sub.pv) {
         d.evidence = vec![reason.clone()];
         d.reason = Some(reason);
-        d.next_step = "use a record in automatic, with OP as the controller wrote it".into();
+        d.next_step = next_step;
         d.seconds = started.elapsed().as_secs_f64();
         return Ok(d);
     }

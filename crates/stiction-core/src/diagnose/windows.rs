@@ -44,10 +44,10 @@ pub(super) fn judge_windows(
             votes: Vec::new(),
         };
         let judged = sub.slice(s, e);
-        let still = super::gates::op_still(judged.op);
+        let still = super::gates::still(judged.op, judged.pv);
         if e - s < req.min_samples {
             // too short: the reason above
-        } else if let Some(reason) = still {
+        } else if let Some((reason, _)) = still {
             v.reason = Some(reason);
         } else {
             let j = judge(&judged, req);
