@@ -63,7 +63,8 @@ pub fn fit_stretch(
     row_of: &dyn Fn(usize) -> usize,
 ) -> Result<Stretch> {
     let file = table.path.display();
-    let n = table.len();
+    // the signals' samples: fewer than the table's rows when rows were merged (repeated times)
+    let n = columns.first().map_or(table.len(), |(_, v)| v.len());
     let gaps: Vec<(&str, usize)> = columns
         .iter()
         .map(|(name, v)| (*name, v.iter().filter(|x| !x.is_finite()).count()))
@@ -75,7 +76,7 @@ pub fn fit_stretch(
         .map(|(name, k)| format!("{name} {k}"))
         .collect::<Vec<_>>()
         .join(", ");
-    if n == 0 {
+    if table.len() == 0 {
         return Err(table.no_rows());
     }
     if total == 0 {

@@ -629,6 +629,26 @@ fn quantify_bad_input_and_insufficient_data() {
 }
 
 #[test]
+fn quantify_keeps_the_first_row_of_a_repeated_time() {
+    // an export that writes every time twice (two historian tags joined on time): the signals
+    // have half the table's rows, and the fit's stretch must be counted in samples, not rows
+    let dir = tmp();
+    let f = closed_loop(dir.path(), "1");
+    let text = std::fs::read_to_string(&f).unwrap();
+    let mut lines = text.lines();
+    let mut out = format!("{}\n", lines.next().unwrap());
+    for line in lines.take(700) {
+        out.push_str(&format!("{line}\n{line}\n"));
+    }
+    let d = write(dir.path(), "twice.csv", &out);
+    let o = ok(&["quantify", &d]);
+    assert!(o.contains("repeat an earlier row's time"), "{o}");
+    let v = json(&ok(&["quantify", &d, "--json"]));
+    assert_eq!(v["status"], "ok", "{v:#}");
+    assert_eq!(v["samples"], 700, "{v:#}");
+}
+
+#[test]
 fn quantify_reads_historian_timestamps() {
     let dir = tmp();
     let f = closed_loop(dir.path(), "1");
