@@ -233,10 +233,13 @@ fn print_human(file: &str, e: &Estimate) {
             if c.estimate_is_optimal { "is" } else { "is NOT" }
         );
     }
-    println!(
-        "  fit: SSE {:.6}, RMSE {:.6}, R² {:.4}",
-        e.sse, e.rmse, e.r2
-    );
+    // R² is undefined when MV never moves (a valve stuck the whole record)
+    let r2 = if e.r2.is_finite() {
+        format!("{:.4}", e.r2)
+    } else {
+        "- (MV does not vary: the valve never moved)".into()
+    };
+    println!("  fit: SSE {:.6}, RMSE {:.6}, R² {r2}", e.sse, e.rmse);
     println!(
         "  {}, {}, {:.2} ms",
         count(e.evaluations, "evaluation", "evaluations"),

@@ -629,6 +629,20 @@ fn quantify_bad_input_and_insufficient_data() {
 }
 
 #[test]
+fn estimate_on_a_valve_that_never_moved_says_so() {
+    let dir = tmp();
+    let mut text = String::from("t,op,mv\n");
+    for k in 0..400 {
+        text.push_str(&format!("{k},{},50\n", 50.0 + (k as f64 / 10.0).sin()));
+    }
+    let f = write(dir.path(), "stuck.csv", &text);
+    let o = ok(&["estimate", &f]);
+    assert!(o.contains("MV does not vary"), "{o}");
+    assert!(!o.contains("NaN"), "{o}");
+    assert!(o.contains("wide relative to d"), "{o}");
+}
+
+#[test]
 fn quantify_keeps_the_first_row_of_a_repeated_time() {
     // an export that writes every time twice (two historian tags joined on time): the signals
     // have half the table's rows, and the fit's stretch must be counted in samples, not rows
