@@ -298,6 +298,16 @@ pub fn unrecorded(x: &[f64]) -> Vec<bool> {
     out
 }
 
+/// A value for a message about the data: four decimals in the usual magnitudes, else four
+/// significant digits in exponent form (OP recorded in raw units of 1e7 reads 4.900e7).
+pub(crate) fn readable(v: f64) -> String {
+    if v != 0.0 && !(1e-3..1e6).contains(&v.abs()) {
+        format!("{v:.3e}")
+    } else {
+        format!("{v:.4}")
+    }
+}
+
 /// Runs of at least this many samples on one straight line count as not recorded.
 pub const MIN_STRAIGHT: usize = 5;
 

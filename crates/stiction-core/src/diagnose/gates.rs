@@ -172,16 +172,8 @@ pub(super) fn op_outside_span(op: &[f64], req: &DiagnoseRequest) -> Option<Strin
         });
     let [closed, open] = req.op_range;
     let margin = OUTSIDE_SPAN * (open - closed);
-    // a few significant digits, in any magnitude
-    let short = |v: f64| {
-        if v != 0.0 && !(1e-3..1e6).contains(&v.abs()) {
-            format!("{v:.3e}")
-        } else {
-            format!("{v:.4}")
-        }
-    };
     (lo < closed - margin || hi > open + margin).then(|| {
-        let (lo, hi) = (short(lo), short(hi));
+        let (lo, hi) = (quality::readable(lo), quality::readable(hi));
         format!(
             "OP runs from {lo} to {hi}, outside the valve's span {closed} to {open}: bands in % of span assume OP is on that span; \
              give --op-range LO:HI (the OP of a closed and of a fully open valve)"

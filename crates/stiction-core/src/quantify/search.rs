@@ -136,7 +136,9 @@ fn gates<'a>(
         ))
     } else if op.iter().all(|&v| v <= 0.0 || v >= 100.0) {
         Some(format!(
-            "OP is at or beyond 0 or 100 % the whole time (it runs from {op_lo} to {op_hi}): saturated, or recorded in other units than % (rescale it to 0-100 % of the valve's span)"
+            "OP is at or beyond 0 or 100 % the whole time (it runs from {} to {}): saturated, or recorded in other units than % (rescale it to 0-100 % of the valve's span)",
+            crate::quality::readable(op_lo),
+            crate::quality::readable(op_hi)
         ))
     } else {
         None
