@@ -27,6 +27,10 @@ pub enum Gate {
     SetpointChanges,
     /// Gaps in the time axis or time not increasing (value: gaps or breaks; limit 0).
     TimeGaps,
+    /// Spikes: one to three samples of PV (or MV) far beyond its own range and back (a historian
+    /// or transmitter glitch), left out (value: share of the samples; limit 1, so it reports and
+    /// never fails).
+    Spikes,
 }
 
 impl Gate {
@@ -42,6 +46,7 @@ impl Gate {
             Gate::MissingValues => "missing_values",
             Gate::SetpointChanges => "setpoint_changes",
             Gate::TimeGaps => "time_gaps",
+            Gate::Spikes => "spikes",
         }
     }
 }
@@ -298,6 +303,57 @@ pub fn unrecorded(x: &[f64]) -> Vec<bool> {
     out
 }
 
+/// A spike is at most this many samples long.
+pub const SPIKE_RUN: usize = 3;
+/// A spike leaves the signal's own range (1st to 99th percentile) by more than this many times
+/// that range: historian junk (0, -9999, 1e6) does by far; a quantised PV's step to a level the
+/// percentiles leave out, or a process's own peak, does not.
+pub const SPIKE_RANGES: f64 = 3.0;
+/// Spikes are rare: when more samples than this share would be spikes, the signal is taken as
+/// it is (they are its own behaviour, not glitches) and none is marked.
+pub const SPIKE_SHARE: f64 = 0.01;
+
+/// The samples of `x` that are spikes: runs of at most [`SPIKE_RUN`] samples beyond the
+/// signal's 1st to 99th percentile range by more than [`SPIKE_RANGES`] times that range, with
+/// the samples either side back inside it. A single historian glitch (a PV of 1e6 in a loop
+/// that runs between 48 and 52) otherwise dominates every fit and index. Non-finite samples are
+/// not spikes (they are missing); none when the signal has no spread or spikes are not rare.
+pub fn spikes(x: &[f64]) -> Vec<bool> {
+    let n = x.len();
+    let mut out = vec![false; n];
+    let mut sorted: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+    if sorted.len() < 20 {
+        return out;
+    }
+    sorted.sort_by(f64::total_cmp);
+    let at = |p: f64| sorted[((sorted.len() - 1) as f64 * p).round() as usize];
+    let (p1, p99) = (at(0.01), at(0.99));
+    let range = p99 - p1;
+    if range.is_nan() || range <= 0.0 {
+        return out;
+    }
+    let far =
+        |v: f64| v.is_finite() && (v > p99 + SPIKE_RANGES * range || v < p1 - SPIKE_RANGES * range);
+    let mut k = 0;
+    while k < n {
+        if !far(x[k]) {
+            k += 1;
+            continue;
+        }
+        let start = k;
+        while k < n && far(x[k]) {
+            k += 1;
+        }
+        if k - start <= SPIKE_RUN {
+            out[start..k].fill(true);
+        }
+    }
+    if out.iter().filter(|&&s| s).count() as f64 > SPIKE_SHARE * n as f64 {
+        out.fill(false);
+    }
+    out
+}
+
 /// A value for a message about the data: four decimals in the usual magnitudes, else four
 /// significant digits in exponent form (OP recorded in raw units of 1e7 reads 4.900e7).
 pub(crate) fn readable(v: f64) -> String {
@@ -337,6 +393,37 @@ pub fn quantum(x: &[f64]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_glitch_is_a_spike_and_a_step_or_an_excursion_is_not() {
+        let base: Vec<f64> = (0..400).map(|k| 50.0 + (k as f64 / 9.0).sin()).collect();
+        // one glitch, and one of three samples
+        let mut x = base.clone();
+        x[100] = 1e6;
+        x[200..203].fill(0.0);
+        let s = spikes(&x);
+        assert!(s[100] && s[200] && s[202], "{:?}", &s[98..104]);
+        assert_eq!(s.iter().filter(|&&v| v).count(), 4);
+        // a step that stays (a valve's slip) is no spike, however large
+        let mut step = base.clone();
+        for v in &mut step[300..] {
+            *v += 30.0;
+        }
+        assert!(!spikes(&step).iter().any(|&v| v));
+        // an excursion of more than three samples is the process's
+        let mut long = base.clone();
+        long[100..105].fill(1e3);
+        assert!(!spikes(&long).iter().any(|&v| v));
+        // a signal without spread, and one whose "spikes" are not rare, are taken as they are
+        let mut flat = vec![50.0; 400];
+        flat[10] = 51.0;
+        assert!(!spikes(&flat).iter().any(|&v| v));
+        let mut often = base;
+        for k in (0..400).step_by(20) {
+            often[k] = 1e3;
+        }
+        assert!(!spikes(&often).iter().any(|&v| v));
+    }
 
     fn loop_record(n: usize) -> (Vec<f64>, Vec<f64>) {
         let op = (0..n)

@@ -257,6 +257,35 @@ fn a_still_op_is_insufficient_data_and_op_off_its_span_is_said() {
 }
 
 #[test]
+fn a_pv_glitch_is_left_out_not_read() {
+    // one historian glitch in a sticky loop's PV used to turn the verdict into "OP does not
+    // drive this variation"
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "loop.csv", "2", &[]);
+    let raw = std::fs::read_to_string(&f).unwrap();
+    let mut lines: Vec<String> = raw.lines().map(String::from).collect();
+    let pv_col = lines[0].split(',').position(|c| c == "pv").unwrap();
+    let mut cells: Vec<String> = lines[501].split(',').map(String::from).collect();
+    cells[pv_col] = "1e6".into();
+    lines[501] = cells.join(",");
+    let p = dir.path().join("glitch.csv");
+    std::fs::write(&p, lines.join("\n") + "\n").unwrap();
+    let v = json(&ok(&[
+        "diagnose",
+        p.to_str().unwrap(),
+        "--sp",
+        "sp",
+        "--json",
+    ]));
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    let warnings = v["warnings"].to_string();
+    assert!(
+        warnings.contains("1 sample in a spike left out"),
+        "{warnings}"
+    );
+}
+
+#[test]
 fn bad_input_is_one_clear_sentence() {
     let dir = tempfile::tempdir().unwrap();
     let f = simulate(dir.path(), "loop.csv", "2", &[]);

@@ -60,6 +60,12 @@ pub(super) fn findings(
             1.0,
         ),
         (
+            Gate::Spikes,
+            excluded.spikes,
+            "in a spike (one to three samples of a signal far beyond its own range and back: a glitch, not the process)",
+            1.0,
+        ),
+        (
             Gate::OpSaturated,
             excluded.saturated,
             "with OP at a limit (0 %, 100 % or pinned at its extreme)",
@@ -147,6 +153,9 @@ fn left_out(x: &Excluded) -> String {
     }
     if x.saturated > 0 {
         parts.push(format!("{} with OP at a limit", x.saturated));
+    }
+    if x.spikes > 0 {
+        parts.push(format!("{} in a spike", x.spikes));
     }
     if x.time_breaks > 0 {
         parts.push(plural(x.time_breaks, "time gap", "time gaps"));

@@ -143,6 +143,12 @@ pub fn diagnose_checked(
     let quality = gates::findings(r, (s, e), stretches.len(), &excluded, req);
     let mut warnings = Vec::new();
     warnings.extend(gates::op_outside_span(&r.op[s..e], req));
+    if excluded.spikes > 0 {
+        warnings.push(format!(
+            "{} left out: a signal far beyond its own range for one to three samples and back (a glitch, not the process); the record is split there",
+            gates::plural(excluded.spikes, "sample in a spike", "samples in spikes")
+        ));
+    }
     if r.sp.is_none() {
         warnings.push(
             "no setpoint column: the control error is taken as the PV's deviation from its mean"

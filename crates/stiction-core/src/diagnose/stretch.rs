@@ -11,6 +11,8 @@ pub(super) struct Excluded {
     pub manual: usize,
     pub missing: usize,
     pub saturated: usize,
+    /// Samples in a spike of any signal ([`crate::quality::spikes`]).
+    pub spikes: usize,
     /// Breaks of the time axis (gaps longer than the limit, or time not increasing).
     pub time_breaks: usize,
 }
@@ -24,6 +26,7 @@ pub(super) fn usable(r: &Record, req: &DiagnoseRequest) -> (Vec<(usize, usize)>,
     let n = r.op.len();
     let mut excluded = Excluded::default();
     let saturated = saturated_samples(r.op, req.op_range);
+    let spiked = spiked_samples(r);
     let breaks = time_breaks(r.time, n, req.limits.gap_steps);
     excluded.time_breaks = breaks.iter().filter(|&&b| b).count();
     let mut ok = vec![true; n];
@@ -37,6 +40,9 @@ pub(super) fn usable(r: &Record, req: &DiagnoseRequest) -> (Vec<(usize, usize)>,
             ok[k] = false;
         } else if !present {
             excluded.missing += 1;
+            ok[k] = false;
+        } else if spiked[k] {
+            excluded.spikes += 1;
             ok[k] = false;
         } else if saturated[k] {
             excluded.saturated += 1;
@@ -58,6 +64,18 @@ pub(super) fn usable(r: &Record, req: &DiagnoseRequest) -> (Vec<(usize, usize)>,
         }
     }
     (out, excluded)
+}
+
+/// Samples in a spike of PV or MV (the measurements; OP's proportional kick at a setpoint step
+/// is a few samples far beyond OP's usual range, and real).
+fn spiked_samples(r: &Record) -> Vec<bool> {
+    let mut out = crate::quality::spikes(r.pv);
+    if let Some(mv) = r.mv {
+        for (o, s) in out.iter_mut().zip(crate::quality::spikes(mv)) {
+            *o |= s;
+        }
+    }
+    out
 }
 
 /// Samples with OP at a limit: at the ends of `op_range` when OP stays within it, or held at the
@@ -148,6 +166,7 @@ mod tests {
                 manual: 5,
                 missing: 1,
                 saturated: 3,
+                spikes: 0,
                 time_breaks: 1
             }
         );
