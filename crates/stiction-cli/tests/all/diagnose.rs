@@ -194,16 +194,41 @@ fn historian_exports_with_timestamps_decimal_commas_and_a_mode_column() {
     assert_eq!(v["verdict"], "stiction", "{v:#}");
 }
 
-#[test]
-fn saturated_and_constant_loops_are_insufficient_data() {
-    let dir = tempfile::tempdir().unwrap();
+/// A record of 1,000 samples with OP held at `op` while PV cycles.
+fn held_op(dir: &Path, name: &str, op: f64) -> std::path::PathBuf {
     let mut text = String::from("t,op,pv\n");
     for k in 0..1000 {
         let pv = 50.0 + (k as f64 * 0.1).sin();
-        text.push_str(&format!("{k},100,{pv}\n"));
+        text.push_str(&format!("{k},{op},{pv}\n"));
     }
-    let p = dir.path().join("sat.csv");
+    let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A copy of the CSV at `path`, named `name`, with column `column` rewritten by `edit` (the
+/// row, from 1 after the header, and the cell).
+fn edited(path: &str, name: &str, column: &str, edit: impl Fn(usize, &str) -> String) -> String {
+    let raw = std::fs::read_to_string(path).unwrap();
+    let mut lines = raw.lines();
+    let header = lines.next().unwrap();
+    let col = header.split(',').position(|c| c == column).unwrap();
+    let mut out = format!("{header}\n");
+    for (row, line) in lines.enumerate() {
+        let mut cells: Vec<String> = line.split(',').map(String::from).collect();
+        cells[col] = edit(row + 1, &cells[col]);
+        out.push_str(&cells.join(","));
+        out.push('\n');
+    }
+    let p = Path::new(path).with_file_name(name);
+    std::fs::write(&p, out).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+#[test]
+fn saturated_and_constant_loops_are_insufficient_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = held_op(dir.path(), "sat.csv", 100.0);
     let v = json(&ok(&["diagnose", p.to_str().unwrap(), "--json"]));
     assert_eq!(v["verdict"], "insufficient_data");
     let text = ok(&["diagnose", p.to_str().unwrap()]);
@@ -214,13 +239,7 @@ fn saturated_and_constant_loops_are_insufficient_data() {
 fn a_still_op_is_insufficient_data_and_op_off_its_span_is_said() {
     let dir = tempfile::tempdir().unwrap();
     // OP held mid-range while PV cycles: the controller did not act, whatever PV does
-    let mut text = String::from("t,op,pv\n");
-    for k in 0..1000 {
-        let pv = 50.0 + (k as f64 * 0.1).sin();
-        text.push_str(&format!("{k},50,{pv}\n"));
-    }
-    let p = dir.path().join("still.csv");
-    std::fs::write(&p, text).unwrap();
+    let p = held_op(dir.path(), "still.csv", 50.0);
     let v = json(&ok(&["diagnose", p.to_str().unwrap(), "--json"]));
     assert_eq!(v["verdict"], "insufficient_data", "{v:#}");
     assert!(
@@ -229,30 +248,13 @@ fn a_still_op_is_insufficient_data_and_op_off_its_span_is_said() {
     );
     // OP in raw units (a flow setpoint of some thousands): bands in % of span need --op-range
     let f = simulate(dir.path(), "loop.csv", "2", &[]);
-    let raw = std::fs::read_to_string(&f).unwrap();
-    let mut lines = raw.lines();
-    let header = lines.next().unwrap();
-    let op_col = header.split(',').position(|c| c == "op").unwrap();
-    let mut scaled = format!("{header}\n");
-    for line in lines {
-        let mut cells: Vec<String> = line.split(',').map(String::from).collect();
-        cells[op_col] = format!("{}", cells[op_col].parse::<f64>().unwrap() * 40.0);
-        scaled.push_str(&cells.join(","));
-        scaled.push('\n');
-    }
-    let p = dir.path().join("raw.csv");
-    std::fs::write(&p, scaled).unwrap();
-    let text = ok(&["diagnose", p.to_str().unwrap(), "--sp", "sp"]);
+    let p = edited(&f, "raw.csv", "op", |_, v| {
+        format!("{}", v.parse::<f64>().unwrap() * 40.0)
+    });
+    let text = ok(&["diagnose", &p, "--sp", "sp"]);
     assert!(text.contains("outside the valve's span 0 to 100"), "{text}");
     assert!(text.contains("--op-range"), "{text}");
-    let text = ok(&[
-        "diagnose",
-        p.to_str().unwrap(),
-        "--sp",
-        "sp",
-        "--op-range",
-        "0:4000",
-    ]);
+    let text = ok(&["diagnose", &p, "--sp", "sp", "--op-range", "0:4000"]);
     assert!(!text.contains("outside the valve's span"), "{text}");
 }
 
@@ -262,21 +264,14 @@ fn a_pv_glitch_is_left_out_not_read() {
     // drive this variation"
     let dir = tempfile::tempdir().unwrap();
     let f = simulate(dir.path(), "loop.csv", "2", &[]);
-    let raw = std::fs::read_to_string(&f).unwrap();
-    let mut lines: Vec<String> = raw.lines().map(String::from).collect();
-    let pv_col = lines[0].split(',').position(|c| c == "pv").unwrap();
-    let mut cells: Vec<String> = lines[501].split(',').map(String::from).collect();
-    cells[pv_col] = "1e6".into();
-    lines[501] = cells.join(",");
-    let p = dir.path().join("glitch.csv");
-    std::fs::write(&p, lines.join("\n") + "\n").unwrap();
-    let v = json(&ok(&[
-        "diagnose",
-        p.to_str().unwrap(),
-        "--sp",
-        "sp",
-        "--json",
-    ]));
+    let p = edited(&f, "glitch.csv", "pv", |row, v| {
+        if row == 501 {
+            "1e6".into()
+        } else {
+            v.into()
+        }
+    });
+    let v = json(&ok(&["diagnose", &p, "--sp", "sp", "--json"]));
     assert_eq!(v["verdict"], "stiction", "{v:#}");
     let warnings = v["warnings"].to_string();
     assert!(
