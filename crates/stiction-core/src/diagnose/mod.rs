@@ -181,19 +181,12 @@ pub fn diagnose_checked(
     };
     if e - s < req.min_samples {
         let reason = too_short(&d.quality, e - s, req);
-        d.evidence = vec![reason.clone()];
-        d.reason = Some(reason);
-        d.next_step = "use a longer record in automatic with every signal present".into();
-        d.seconds = started.elapsed().as_secs_f64();
-        return Ok(d);
+        let next_step = "use a longer record in automatic with every signal present".into();
+        return Ok(unjudged(d, reason, next_step, started));
     }
     let sub = r.slice(s, e);
     if let Some((reason, next_step)) = gates::still(sub.op, sub.pv) {
-        d.evidence = vec![reason.clone()];
-        d.reason = Some(reason);
-        d.next_step = next_step;
-        d.seconds = started.elapsed().as_secs_f64();
-        return Ok(d);
+        return Ok(unjudged(d, reason, next_step, started));
     }
     let j = judge(&sub, req);
     d.verdict = j.decision.verdict;
@@ -211,6 +204,15 @@ pub fn diagnose_checked(
     d.oscillation = Some(osc);
     d.seconds = started.elapsed().as_secs_f64();
     Ok(d)
+}
+
+/// `d` as `insufficient_data` (its default verdict) for `reason`, with the next step.
+fn unjudged(mut d: Diagnosis, reason: String, next_step: String, started: Instant) -> Diagnosis {
+    d.evidence = vec![reason.clone()];
+    d.reason = Some(reason);
+    d.next_step = next_step;
+    d.seconds = started.elapsed().as_secs_f64();
+    d
 }
 
 /// Why a record too short to judge is so.

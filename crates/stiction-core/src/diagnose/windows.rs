@@ -43,23 +43,23 @@ pub(super) fn judge_windows(
             period: None,
             votes: Vec::new(),
         };
-        let judged = sub.slice(s, e);
-        let still = super::gates::still(judged.op, judged.pv);
-        if e - s < req.min_samples {
-            // too short: the reason above
-        } else if let Some((reason, _)) = still {
-            v.reason = Some(reason);
-        } else {
-            let j = judge(&judged, req);
-            v.verdict = j.decision.verdict;
-            v.confidence = j.decision.confidence;
-            v.reason = j.decision.reason;
-            v.period = j
-                .oscillation
-                .oscillating
-                .then_some(j.oscillation.period)
-                .flatten();
-            v.votes = j.families.iter().map(|f| (f.family, f.vote)).collect();
+        if e - s >= req.min_samples {
+            let judged = sub.slice(s, e);
+            match super::gates::still(judged.op, judged.pv) {
+                Some((reason, _)) => v.reason = Some(reason),
+                None => {
+                    let j = judge(&judged, req);
+                    v.verdict = j.decision.verdict;
+                    v.confidence = j.decision.confidence;
+                    v.reason = j.decision.reason;
+                    v.period = j
+                        .oscillation
+                        .oscillating
+                        .then_some(j.oscillation.period)
+                        .flatten();
+                    v.votes = j.families.iter().map(|f| (f.family, f.vote)).collect();
+                }
+            }
         }
         out.push(v);
         start = end;

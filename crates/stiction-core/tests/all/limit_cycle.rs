@@ -62,6 +62,11 @@ fn loop_family(d: &Diagnosis) -> &FamilyEvidence {
         .unwrap()
 }
 
+/// Whether one of the diagnosis's warnings says `text`.
+fn warned(d: &Diagnosis, text: &str) -> bool {
+    d.warnings.iter().any(|w| w.contains(text))
+}
+
 #[test]
 fn a_fast_sticky_loop_is_called_sticky_with_its_describing_function_band() {
     let d = judge(&fast_loop(2.0, 1.3, None));
@@ -158,13 +163,7 @@ fn where_the_fit_misses_short_sticks_the_describing_functions_band_is_reported()
         .map(|(_, v)| *v)
         .unwrap();
     assert!(closed < band.band_percent_of_span / 1.5, "{band:?}");
-    assert!(
-        d.warnings
-            .iter()
-            .any(|w| w.contains("differ by more than 1.5x")),
-        "{:?}",
-        d.warnings
-    );
+    assert!(warned(&d, "differ by more than 1.5x"), "{:?}", d.warnings);
 }
 
 #[test]
@@ -186,11 +185,5 @@ fn issue_14s_example_is_called_sticky_by_the_cycle_that_sustains_itself() {
     let band = d.band.as_ref().unwrap();
     assert_eq!(band.source, BandSource::ClosedLoop, "{band:?}");
     assert!((1.5..3.0).contains(&band.band_percent_of_span), "{band:?}");
-    assert!(
-        d.warnings
-            .iter()
-            .any(|w| w.contains("cycle that sustains itself")),
-        "{:?}",
-        d.warnings
-    );
+    assert!(warned(&d, "cycle that sustains itself"), "{:?}", d.warnings);
 }
