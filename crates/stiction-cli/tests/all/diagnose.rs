@@ -281,6 +281,30 @@ fn a_pv_glitch_is_left_out_not_read() {
 }
 
 #[test]
+fn historian_states_in_a_few_cells_are_bridged_not_a_split() {
+    // four PV cells of "Bad Input", "I/O Timeout" or "No Data" (as PI exports them) used to cut
+    // the record into four stretches; the last, 800 samples, was judged, with a band of 0.00 %
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "loop.csv", "2", &[]);
+    let p = edited(&f, "states.csv", "pv", |row, v| match row {
+        301 | 302 => "Bad Input".into(),
+        701 => "I/O Timeout".into(),
+        1201 => "No Data".into(),
+        _ => v.into(),
+    });
+    let v = json(&ok(&["diagnose", &p, "--sp", "sp", "--json"]));
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    assert_eq!(v["stretches"].as_array().unwrap().len(), 1, "{v:#}");
+    let band = v["band"]["band_percent_of_span"].as_f64().unwrap();
+    assert!((band - 2.0).abs() < 0.2, "band {band}");
+    let warnings = v["warnings"].to_string();
+    assert!(
+        warnings.contains("3 short gaps (4 samples with a missing value) bridged"),
+        "{warnings}"
+    );
+}
+
+#[test]
 fn bad_input_is_one_clear_sentence() {
     let dir = tempfile::tempdir().unwrap();
     let f = simulate(dir.path(), "loop.csv", "2", &[]);

@@ -3,7 +3,8 @@
 //! the best excitation a loop gets), then independent families of evidence, each with its value,
 //! threshold and vote, and a verdict that says why.
 //!
-//! - `stretch` and `gates`: the usable stretches and the data-quality findings;
+//! - `bridge`, `stretch` and `gates`: short gaps bridged, the usable stretches and the
+//!   data-quality findings;
 //! - [`oscillation`]: does the loop oscillate (for the shape family);
 //! - [`evidence`]: the families (shape, model, stick-slip, valve), one file each behind a trait;
 //! - `verdict`: families that agree decide, families that conflict give `undetermined`;
@@ -11,6 +12,7 @@
 //! - `windows`: the same judgement per window of the record.
 
 mod band;
+mod bridge;
 pub mod evidence;
 mod gates;
 pub mod oscillation;
@@ -134,6 +136,16 @@ pub fn diagnose_checked(
     let started = Instant::now();
     request::check_record(r)?;
     let n = r.op.len();
+    let breaks = stretch::time_breaks(r.time, n, req.limits.gap_steps);
+    let bridged = bridge::short_gaps(r, &breaks);
+    let filled;
+    let r = match &bridged {
+        Some(b) => {
+            filled = b.record(r);
+            &filled
+        }
+        None => r,
+    };
     let (stretches, excluded) = stretch::usable(r, req);
     let (s, e) = stretches
         .iter()
@@ -143,6 +155,15 @@ pub fn diagnose_checked(
     let quality = gates::findings(r, (s, e), stretches.len(), &excluded, req);
     let mut warnings = Vec::new();
     warnings.extend(gates::op_outside_span(&r.op[s..e], req));
+    if let Some(b) = &bridged {
+        warnings.push(format!(
+            "{} ({}) bridged by straight lines between their neighbours, so they do not split the record (at most {} samples in a row and {} % of the record are bridged)",
+            gates::plural(b.runs, "short gap", "short gaps"),
+            gates::plural(b.samples, "sample with a missing value", "samples with a missing value"),
+            bridge::MAX_RUN,
+            bridge::MAX_SHARE * 100.0
+        ));
+    }
     if excluded.spikes > 0 {
         warnings.push(format!(
             "{} left out: a signal far beyond its own range for one to three samples and back (a glitch, not the process); the record is split there",

@@ -106,7 +106,7 @@ fn saturated_samples(op: &[f64], [lo_range, hi_range]: [f64; 2]) -> Vec<bool> {
 
 /// `true` at a sample that starts after a gap (a time step longer than `gap_steps` median steps)
 /// or where time does not increase.
-fn time_breaks(time: Option<&[f64]>, n: usize, gap_steps: f64) -> Vec<bool> {
+pub(super) fn time_breaks(time: Option<&[f64]>, n: usize, gap_steps: f64) -> Vec<bool> {
     let Some(t) = time else {
         return vec![false; n];
     };

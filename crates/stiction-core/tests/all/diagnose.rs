@@ -102,13 +102,30 @@ fn unusable_samples_are_left_out_and_gaps_split_the_record() {
         .iter()
         .any(|f| f.gate == Gate::TimeGaps && !f.passed));
     assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
-    // missing values (NaN) split it too
+    // a missing value or three in a row are bridged by a straight line, with a note
     let mut pv = sticky.pv.clone();
     pv[300] = f64::NAN;
+    pv[900..903].fill(f64::NAN);
     let mut r = record(&sticky);
     r.pv = &pv;
     let d = diagnose(&r, &quick()).unwrap();
-    assert_eq!(d.stretches, vec![[0, 300], [301, 2000]]);
+    assert_eq!(d.stretches, vec![[0, 2000]]);
+    assert!(
+        d.warnings.iter().any(|w| w.starts_with(
+            "2 short gaps (4 samples with a missing value) bridged by straight lines"
+        )),
+        "{:?}",
+        d.warnings
+    );
+    assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
+    // a longer run of missing values splits it
+    pv[300] = sticky.pv[300];
+    pv[900..904].fill(f64::NAN);
+    let mut r = record(&sticky);
+    r.pv = &pv;
+    let d = diagnose(&r, &quick()).unwrap();
+    assert_eq!(d.stretches, vec![[0, 900], [904, 2000]]);
+    assert!(d.warnings.iter().all(|w| !w.contains("bridged")));
     assert_eq!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
 }
 
