@@ -120,6 +120,18 @@ pub struct Record<'a> {
 }
 
 impl<'a> Record<'a> {
+    /// OP and PV alone: no setpoint, valve position, time or mode.
+    pub fn new(op: &'a [f64], pv: &'a [f64]) -> Self {
+        Record {
+            op,
+            pv,
+            sp: None,
+            mv: None,
+            time: None,
+            auto: None,
+        }
+    }
+
     /// Samples `[start, end)` of every signal.
     pub fn slice(&self, start: usize, end: usize) -> Record<'a> {
         Record {
