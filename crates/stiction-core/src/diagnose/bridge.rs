@@ -96,10 +96,6 @@ pub(super) fn short_gaps(r: &Record, breaks: &[bool]) -> Option<Bridged> {
 mod tests {
     use super::*;
 
-    fn record<'a>(op: &'a [f64], pv: &'a [f64]) -> Record<'a> {
-        Record::new(op, pv)
-    }
-
     #[test]
     fn a_missing_cell_is_bridged_by_a_straight_line() {
         let op: Vec<f64> = (0..400).map(|k| k as f64).collect();
@@ -107,7 +103,7 @@ mod tests {
         pv[100] = f64::NAN;
         pv[200] = f64::NAN;
         pv[201] = f64::NAN;
-        let b = short_gaps(&record(&op, &pv), &vec![false; 400]).expect("two short gaps");
+        let b = short_gaps(&Record::new(&op, &pv), &vec![false; 400]).expect("two short gaps");
         assert_eq!((b.runs, b.samples), (2, 3));
         assert!((b.pv[100] - 100.0).abs() < 1e-12);
         assert!((b.pv[200] - 200.0).abs() < 1e-12 && (b.pv[201] - 201.0).abs() < 1e-12);
@@ -121,16 +117,16 @@ mod tests {
         pv[50..54].fill(f64::NAN); // four samples: too long
         pv[0] = f64::NAN; // at the edge: nothing to bridge from
         pv[399] = f64::NAN;
-        assert!(short_gaps(&record(&op, &pv), &vec![false; 400]).is_none());
+        assert!(short_gaps(&Record::new(&op, &pv), &vec![false; 400]).is_none());
         let mut pv = vec![2.0; 400];
         pv[100] = f64::NAN;
         let mut breaks = vec![false; 400];
         breaks[101] = true; // the time axis breaks right after the gap
-        assert!(short_gaps(&record(&op, &pv), &breaks).is_none());
+        assert!(short_gaps(&Record::new(&op, &pv), &breaks).is_none());
         let mut pv = vec![2.0; 400];
         for k in (10..400).step_by(50) {
             pv[k] = f64::NAN; // 8 gaps: 2 % of the record
         }
-        assert!(short_gaps(&record(&op, &pv), &vec![false; 400]).is_none());
+        assert!(short_gaps(&Record::new(&op, &pv), &vec![false; 400]).is_none());
     }
 }
