@@ -17,8 +17,9 @@ use stiction_core::quantify::{
   stiction quantify CHEM1.csv --op OP --pv PV --ts 1 --plot out/chem1
   stiction quantify export.parquet --op FIC101.OP --pv FIC101.PV --tz America/Chicago
 
-Missing values (blank, NaN, #N/A, historian states such as Bad Input) are gaps: the longest
-stretch without one is used, and a note says which.")]
+Missing values (blank, NaN, #N/A, historian states such as Bad Input) are gaps: short ones (at
+most 3 samples in a row, 1 % of the record) are bridged by straight lines; past longer ones the
+longest stretch without a gap is used, and a note says which.")]
 pub struct Args {
     /// Data file: CSV with a header line, .csv.gz, a workbook, Parquet, or - for standard input
     file: PathBuf,
@@ -91,15 +92,15 @@ pub fn run(a: Args) -> Result<()> {
     };
     let lf = read_loop(&table, &signals, &a.reading.time_spec()?)?;
     let ts = lf.ts;
-    // a fit needs a record without gaps: the longest stretch without one
+    // a fit needs a record without gaps: short ones bridged, then the longest stretch without one
     let stretch = data::fit_stretch(
         &table,
         &[(a.op.as_str(), &lf.op), (a.pv.as_str(), &lf.pv)],
         2,
         &|k| lf.row_of(k),
     )?;
-    let op = lf.op[stretch.start..stretch.end].to_vec();
-    let pv = lf.pv[stretch.start..stretch.end].to_vec();
+    let op = stretch.columns[0][stretch.start..stretch.end].to_vec();
+    let pv = stretch.columns[1][stretch.start..stretch.end].to_vec();
     let time = lf
         .time
         .as_ref()

@@ -69,23 +69,28 @@ fn bounds(
     Ok(ranges)
 }
 
-/// The longest stretch where `a` and `b` have no gap, with a note when it is not the whole
+/// `a` and `b` over the longest stretch where neither has a gap once their short gaps are
+/// bridged ([`record::short_gaps`]), with a note when they were bridged or it is not the whole
 /// record, or the sentence why none is long enough (the CLI's `fit_stretch`, in samples).
+type FitStretch = (Vec<f64>, Vec<f64>, Option<String>);
 fn fit_stretch(
     (a_name, a): (&str, &[f64]),
     (b_name, b): (&str, &[f64]),
     least: usize,
-) -> PyResult<(usize, usize, Option<String>)> {
+) -> PyResult<FitStretch> {
     let n = a.len();
+    let runs = record::short_gaps(&[a, b], &|_| true);
+    let (a, b) = (record::bridged(a, &runs), record::bridged(b, &runs));
+    let bridged = (!runs.is_empty()).then(|| record::bridged_note(&runs, ("sample", "samples")));
     let gaps = |v: &[f64]| v.iter().filter(|x| !x.is_finite()).count();
-    let (ga, gb) = (gaps(a), gaps(b));
+    let (ga, gb) = (gaps(&a), gaps(&b));
     if ga + gb == 0 {
         if n < least {
             return Err(bad(format!(
                 "only {n} samples; at least {least} samples are needed"
             )));
         }
-        return Ok((0, n, None));
+        return Ok((a, b, bridged));
     }
     let which = [(a_name, ga), (b_name, gb)]
         .iter()
@@ -93,7 +98,7 @@ fn fit_stretch(
         .map(|(name, k)| format!("{name} {k}"))
         .collect::<Vec<_>>()
         .join(", ");
-    let (s, e) = longest_clean(&[a, b]).unwrap_or((0, 0));
+    let (s, e) = longest_clean(&[&a, &b]).unwrap_or((0, 0));
     if e - s < least {
         return Err(bad(format!(
             "no stretch of at least {least} samples without missing values ({} missing: {which}; the longest stretch without gaps has {} samples); fill the gaps or pass a longer stretch",
@@ -101,13 +106,16 @@ fn fit_stretch(
             e - s
         )));
     }
-    let note = format!(
+    let mut note = format!(
         "{} values missing ({which}); using samples {s} to {}, the longest stretch without gaps ({} of {n})",
         ga + gb,
         e - 1,
         e - s
     );
-    Ok((s, e, Some(note)))
+    if let Some(bridged) = bridged {
+        note = format!("{bridged}; {note}");
+    }
+    Ok((a[s..e].to_vec(), b[s..e].to_vec(), Some(note)))
 }
 
 /// Quantify stiction from OP and PV alone: the `Quantification` as JSON (the CLI's `quantify
@@ -156,8 +164,8 @@ pub fn quantify(
         )),
         e => bad(e.to_string()),
     })?;
-    let (s, e, note) = fit_stretch(("op", &p.signals.op), ("pv", &p.signals.pv), 2)?;
-    let (op, pv) = (&p.signals.op[s..e], &p.signals.pv[s..e]);
+    let (op, pv, note) = fit_stretch(("op", &p.signals.op), ("pv", &p.signals.pv), 2)?;
+    let (op, pv) = (&op[..], &pv[..]);
     let mut req = QuantifyRequest::new(kind, method);
     req.ts = p.ts;
     req.seed = seed;
@@ -262,8 +270,8 @@ pub fn estimate(
             mv.len()
         )));
     }
-    let (s, e, note) = fit_stretch(("op", &op), ("mv", &mv), core_estimate::MIN_SAMPLES)?;
-    let (op, mv) = (&op[s..e], &mv[s..e]);
+    let (op, mv, note) = fit_stretch(("op", &op), ("mv", &mv), core_estimate::MIN_SAMPLES)?;
+    let (op, mv) = (&op[..], &mv[..]);
     let (lo, hi) = op
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {

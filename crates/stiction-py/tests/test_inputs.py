@@ -44,6 +44,18 @@ def test_gaps_and_modes(loop):
     assert d.analysed[0] >= 100
 
 
+def test_a_short_gap_is_bridged_not_a_split(loop):
+    df = loop.copy()
+    df["pv"] = df["pv"].astype(object)
+    df.loc[300, "pv"] = "Bad Input"
+    d = stiction.diagnose(df, sp="sp", quantify=False)
+    assert list(d.analysed) == [0, len(df)]
+    assert any("1 short gap (1 sample with a missing value) bridged" in w for w in d.warnings)
+    q = stiction.quantify(df)
+    assert any("1 short gap (1 sample with a missing value) bridged" in n for n in q.notes)
+    assert q.params["d"] == pytest.approx(stiction.quantify(loop).params["d"], rel=0.05)
+
+
 def test_models_and_simulate():
     op = np.sin(np.linspace(0, 20, 500))
     mv = stiction.Stenman(d=0.5).simulate(op)

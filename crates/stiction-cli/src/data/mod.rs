@@ -17,6 +17,7 @@ pub mod time;
 mod proptests;
 
 pub use format::in_guarded_reader;
+use stiction_core::record;
 pub use stiction_core::record::longest_clean;
 pub use table::Table;
 pub use text::sniff_delimiter;
@@ -51,10 +52,13 @@ pub struct Stretch {
     pub end: usize,
     /// What was treated as missing and which stretch is used, for a note; `None` without gaps.
     pub note: Option<String>,
+    /// The columns, whole, with their short gaps bridged (see
+    /// [`stiction_core::record::short_gaps`]).
+    pub columns: Vec<Vec<f64>>,
 }
 
-/// The longest stretch without gaps in `columns` (name, values with NaN at gaps), or one
-/// sentence saying why there is none of at least `min_samples`. `row_of` maps a sample to its
+/// The longest stretch without gaps in `columns` (name, values with NaN at gaps) once their short
+/// gaps are bridged, or one sentence saying why there is none of at least `min_samples`. `row_of` maps a sample to its
 /// row of the table (the rows may have been sorted by time).
 pub fn fit_stretch(
     table: &Table,
@@ -65,6 +69,16 @@ pub fn fit_stretch(
     let file = table.path.display();
     // the signals' samples: fewer than the table's rows when rows were merged (repeated times)
     let n = columns.first().map_or(table.len(), |(_, v)| v.len());
+    let values: Vec<&[f64]> = columns.iter().map(|(_, v)| *v).collect();
+    let runs = record::short_gaps(&values, &|_| true);
+    let filled: Vec<Vec<f64>> = values.iter().map(|v| record::bridged(v, &runs)).collect();
+    let bridge_note =
+        (!runs.is_empty()).then(|| record::bridged_note(&runs, ("sample", "samples")));
+    let columns: Vec<(&str, &[f64])> = columns
+        .iter()
+        .zip(&filled)
+        .map(|((name, _), v)| (*name, v.as_slice()))
+        .collect();
     let gaps: Vec<(&str, usize)> = columns
         .iter()
         .map(|(name, v)| (*name, v.iter().filter(|x| !x.is_finite()).count()))
@@ -89,7 +103,8 @@ pub fn fit_stretch(
         return Ok(Stretch {
             start: 0,
             end: n,
-            note: None,
+            note: bridge_note,
+            columns: filled,
         });
     }
     let values: Vec<&[f64]> = columns.iter().map(|(_, v)| *v).collect();
@@ -105,16 +120,21 @@ pub fn fit_stretch(
             if b > a { format!(", {}", lines(a, b)) } else { String::new() }
         );
     }
+    let mut note = format!(
+        "{} treated as missing ({which}: blank, NaN, #N/A or a historian state such as Bad Input); \
+         using {}, the longest stretch without gaps ({} of {n})",
+        count(total, "cell", "cells"),
+        lines(a, b),
+        count(b - a, "sample", "samples"),
+    );
+    if let Some(bridged) = bridge_note {
+        note = format!("{bridged}; {note}");
+    }
     Ok(Stretch {
         start: a,
         end: b,
-        note: Some(format!(
-            "{} treated as missing ({which}: blank, NaN, #N/A or a historian state such as Bad Input); \
-             using {}, the longest stretch without gaps ({} of {n})",
-            count(total, "cell", "cells"),
-            lines(a, b),
-            count(b - a, "sample", "samples"),
-        )),
+        note: Some(note),
+        columns: filled,
     })
 }
 
@@ -150,7 +170,7 @@ pub fn read_pair(
         min_samples,
         &|k| k,
     )?;
-    let av = av[s.start..s.end].to_vec();
+    let av = s.columns[0][s.start..s.end].to_vec();
     let (lo, hi) = av
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
@@ -165,7 +185,7 @@ pub fn read_pair(
     }
     Ok(Pair {
         a: av,
-        b: bv[s.start..s.end].to_vec(),
+        b: s.columns[1][s.start..s.end].to_vec(),
         note: s.note,
     })
 }

@@ -226,8 +226,10 @@ fn parquet_reads_like_its_csv() {
     let v = json(&ok(&["quantify", s(&pandas), "--json"]));
     assert_eq!(v["params"]["d"].as_f64().unwrap(), reference);
     assert_eq!(v["ts"], 1.0);
-    // a null is a gap: the longest stretch without one is used
-    pv[1000] = None;
+    // a null is a gap: the longest stretch without one is used (a gap of 4, past a bridge)
+    for v in &mut pv[1000..1004] {
+        *v = None;
+    }
     let spark = dir.path().join("spark.parquet");
     write_parquet(
         &spark,
@@ -244,7 +246,7 @@ fn parquet_reads_like_its_csv() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(
-        err.contains("1 cell treated as missing (pv 1") && err.contains("using row 1 to 1000"),
+        err.contains("4 cells treated as missing (pv 4") && err.contains("using row 1 to 1000"),
         "{err}"
     );
 }
@@ -510,8 +512,8 @@ fn rows_out_of_time_order_are_sorted() {
     );
 }
 
-/// The loop with a few blank, `Bad` and `#N/A` cells.
-fn with_gaps(dir: &Path) -> PathBuf {
+/// The loop with a few blank, `Bad` and `#N/A` cells: `na_lines` lines of `#N/A` from line 901.
+fn with_gaps(dir: &Path, na_lines: usize) -> PathBuf {
     let (csv, _) = sticky(dir);
     let text = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<String> = text
@@ -522,7 +524,7 @@ fn with_gaps(dir: &Path) -> PathBuf {
             match i {
                 300 => c[2] = String::new(),
                 301 => c[4] = "Bad".into(),
-                900 => c[4] = "#N/A".into(),
+                i if (900..900 + na_lines).contains(&i) => c[4] = "#N/A".into(),
                 _ => {}
             }
             c.join(",")
@@ -534,24 +536,34 @@ fn with_gaps(dir: &Path) -> PathBuf {
 }
 
 #[test]
-fn quantify_uses_the_longest_stretch_without_gaps() {
+fn quantify_bridges_short_gaps_and_uses_the_longest_stretch_past_long_ones() {
     let dir = tempfile::tempdir().unwrap();
-    let p = with_gaps(dir.path());
+    // gaps of 2 and 1 samples: bridged, the whole record is fitted
+    let p = with_gaps(dir.path(), 1);
     let out = ok(&["quantify", s(&p)]);
     assert!(
-        out.contains("3 cells treated as missing (op 1, pv 2")
+        out.contains("2 short gaps (3 samples with a missing value) bridged by straight lines"),
+        "{out}"
+    );
+    assert!(out.contains("1500 samples at 1 s"), "{out}");
+    // a gap of 4 samples splits the record: the longest stretch beside it is fitted
+    let p = with_gaps(dir.path(), 4);
+    let out = ok(&["quantify", s(&p)]);
+    assert!(
+        out.contains("1 short gap (2 samples with a missing value) bridged")
+            && out.contains("4 cells treated as missing (pv 4")
             && out.contains(
-                "using line 902 to 1501, the longest stretch without gaps (600 samples of 1500)"
+                "using line 2 to 900, the longest stretch without gaps (899 samples of 1500)"
             ),
         "{out}"
     );
-    assert!(out.contains("600 samples at 1 s"), "{out}");
+    assert!(out.contains("899 samples at 1 s"), "{out}");
 }
 
 #[test]
 fn diagnose_passes_gaps_to_the_core() {
     let dir = tempfile::tempdir().unwrap();
-    let p = with_gaps(dir.path());
+    let p = with_gaps(dir.path(), 1);
     let out = ok(&["diagnose", s(&p), "--sp", "sp"]);
     assert!(
         out.contains("3 cells treated as missing (op 1, pv 2"),

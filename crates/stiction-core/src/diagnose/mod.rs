@@ -137,7 +137,7 @@ pub fn diagnose_checked(
     request::check_record(r)?;
     let n = r.op.len();
     let breaks = stretch::time_breaks(r.time, n, req.limits.gap_steps);
-    let bridged = bridge::short_gaps(r, &breaks);
+    let bridged = bridge::short_gaps_bridged(r, &breaks);
     let filled;
     let r = match &bridged {
         Some(b) => {
@@ -156,13 +156,7 @@ pub fn diagnose_checked(
     let mut warnings = Vec::new();
     warnings.extend(gates::op_outside_span(&r.op[s..e], req));
     if let Some(b) = &bridged {
-        warnings.push(format!(
-            "{} ({}) bridged by straight lines between their neighbours, so they do not split the record (at most {} samples in a row and {} % of the record are bridged)",
-            gates::plural(b.runs, "short gap", "short gaps"),
-            gates::plural(b.samples, "sample with a missing value", "samples with a missing value"),
-            bridge::MAX_RUN,
-            bridge::MAX_SHARE * 100.0
-        ));
+        warnings.push(crate::record::bridged_note(&b.runs, ("sample", "samples")));
     }
     if excluded.spikes > 0 {
         warnings.push(format!(

@@ -112,7 +112,9 @@ def quantify(
     """Quantify stiction from OP and PV alone (closed-loop Hammerstein identification), as
     ``stiction quantify``: the apparent stiction band, the fitted model and its fit.
 
-    Data as for :func:`diagnose`. The longest stretch without gaps is used (see ``notes``).
+    Data as for :func:`diagnose`. Short gaps (at most 3 samples in a row, at most 1 % of the
+    record) are bridged by straight lines; past longer gaps the longest stretch without one is
+    used (see ``notes``).
     model: stenman, he, kano, choudhury; method: exact (Stenman's default), aco-r, aco, grid.
     integrating: True (a level loop), False (self-regulating), None (tried both ways).
     """

@@ -9,6 +9,11 @@
 use crate::diagnose::LoopRecord;
 use std::borrow::Cow;
 
+mod gaps;
+pub use gaps::{
+    bridged, bridged_note, longest_clean, short_gaps, BRIDGE_MAX_RUN, BRIDGE_MAX_SHARE,
+};
+
 /// The signals of one loop, as columns (gaps NaN; `auto` `true` where the controller is in
 /// automatic; `time` in seconds).
 #[derive(Debug, Clone)]
@@ -325,29 +330,6 @@ pub fn mode_word(cell: &str) -> Option<bool> {
     }
 }
 
-/// The longest run of rows `[start, end)` where every column holds a finite value (the first such
-/// run when several are equally long); `None` when no row does. Fits (`quantify`, `estimate`)
-/// use it: they need a record without gaps.
-pub fn longest_clean(columns: &[&[f64]]) -> Option<(usize, usize)> {
-    let n = columns.iter().map(|c| c.len()).min()?;
-    let clean = |k: usize| columns.iter().all(|c| c[k].is_finite());
-    let mut best: Option<(usize, usize)> = None;
-    let mut start = None;
-    for k in 0..=n {
-        match (start, k < n && clean(k)) {
-            (None, true) => start = Some(k),
-            (Some(s), false) => {
-                if best.is_none_or(|(a, b)| k - s > b - a) {
-                    best = Some((s, k));
-                }
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    best
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -370,17 +352,6 @@ mod tests {
             note.contains("1 step goes back") && note.contains("1 row repeats"),
             "{note}"
         );
-    }
-
-    #[test]
-    fn the_longest_clean_run() {
-        let nan = f64::NAN;
-        let a = [1.0, nan, 1.0, 1.0, 1.0, 1.0, nan];
-        let b = [1.0, 1.0, 1.0, nan, 1.0, 1.0, 1.0];
-        assert_eq!(longest_clean(&[&a, &b]), Some((4, 6)));
-        assert_eq!(longest_clean(&[&a]), Some((2, 6)));
-        assert_eq!(longest_clean(&[&[nan, nan]]), None);
-        assert_eq!(longest_clean(&[&[]]), None);
     }
 
     #[test]
