@@ -37,6 +37,35 @@ pub fn sniff_delimiter(header: &str) -> u8 {
         .unwrap_or(b',')
 }
 
+/// Line numbers from byte offsets, counted as the reading goes. (The csv reader's own line count
+/// runs one short on files with CRLF line ends, as Windows programs write them: a record's
+/// position there starts at the previous line's LF.)
+#[derive(Default)]
+struct LineCounter {
+    byte: usize,
+    newlines: u64,
+}
+
+impl LineCounter {
+    /// The line (from 1) of the record at `byte` of `text` (offsets only grow).
+    fn line_at(&mut self, text: &[u8], byte: usize) -> u64 {
+        let start = byte
+            + text[byte.min(text.len())..]
+                .iter()
+                .take_while(|&&c| c == b'\r' || c == b'\n')
+                .count();
+        let start = start.min(text.len());
+        if start >= self.byte {
+            self.newlines += text[self.byte..start]
+                .iter()
+                .filter(|&&c| c == b'\n')
+                .count() as u64;
+            self.byte = start;
+        }
+        self.newlines + 1
+    }
+}
+
 /// A table from delimited text.
 pub fn read(path: &Path, text: &str) -> Result<Table> {
     let file = path.display();
@@ -74,6 +103,7 @@ pub fn read(path: &Path, text: &str) -> Result<Table> {
     let mut table = Table::new(path, headers);
     let width = table.headers.len();
     let mut record = csv::StringRecord::new();
+    let mut lines = LineCounter::default();
     loop {
         let more = reader
             .read_record(&mut record)
@@ -81,7 +111,10 @@ pub fn read(path: &Path, text: &str) -> Result<Table> {
         if !more {
             break;
         }
-        let line = record.position().map_or(0, |p| p.line()) + line_offset;
+        let line = record
+            .position()
+            .map_or(0, |p| lines.line_at(body.as_bytes(), p.byte() as usize))
+            + line_offset;
         if record.len() > width && record.iter().skip(width).any(|c| !c.trim().is_empty()) {
             bail!(
                 "{file}: line {line} has {} cells but the header names {width} columns; remove the extra cells or name the column",

@@ -306,6 +306,33 @@ fn utf16_text_and_excel_sep_lines_are_read() {
     assert_eq!(band(&[s(&sep)]), reference);
 }
 
+#[test]
+fn crlf_files_name_the_right_line() {
+    // Windows programs end lines with CRLF; the csv reader's own count ran one line short there
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, _) = sticky(dir.path());
+    let text = std::fs::read_to_string(&csv).unwrap();
+    for (name, end) in [("lf.csv", "\n"), ("crlf.csv", "\r\n")] {
+        let body: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                if i == 41 {
+                    l.replacen(',', ",n/a?,", 1)
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect();
+        let p = dir.path().join(name);
+        std::fs::write(&p, body.join(end) + end).unwrap();
+        let out = stiction(&["quantify", s(&p)]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(err.contains("line 42"), "{name}: {err}");
+    }
+}
+
 /// Writes sample k's timestamp.
 type Stamper = Box<dyn Fn(usize) -> String>;
 
