@@ -121,8 +121,12 @@ pub struct LoopFile {
     pub missing: Vec<(String, usize)>,
     /// What the reader decided that a person should know (time order, time form, zone).
     pub notes: Vec<String>,
-    /// The table row of each sample, when the rows were sorted by time (else sample k is row k).
+    /// The table row of each sample, when the rows were sorted by time or put on a grid (else
+    /// sample k is row k).
     pub rows: Option<Vec<usize>>,
+    /// The signals were stored at their own times and put on a regular grid: their blank cells
+    /// stand for "nothing stored here" (the core's note says so), not for gaps.
+    pub on_grid: bool,
 }
 
 impl LoopFile {
@@ -159,10 +163,11 @@ impl LoopFile {
         self.missing.iter().map(|(_, k)| k).sum()
     }
 
-    /// One sentence on the missing cells, if any (for diagnose, report and batch).
+    /// One sentence on the missing cells, if any (for diagnose, report and batch); none when the
+    /// signals were put on a grid (the blanks were between stored values).
     pub fn missing_note(&self) -> Option<String> {
         let total = self.missing_total();
-        (total > 0).then(|| {
+        (total > 0 && !self.on_grid).then(|| {
             let which: Vec<String> = self
                 .missing
                 .iter()
@@ -331,6 +336,7 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
         e => anyhow::anyhow!("{file}: {e}"),
     })?;
     notes.extend(p.notes);
+    let on_grid = p.on_grid;
     let v = p.signals;
     Ok(LoopFile {
         op: v.op.into_owned(),
@@ -343,5 +349,6 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
         missing,
         notes,
         rows: p.rows,
+        on_grid,
     })
 }

@@ -56,6 +56,16 @@ def test_a_short_gap_is_bridged_not_a_split(loop):
     assert q.params["d"] == pytest.approx(stiction.quantify(loop).params["d"], rel=0.05)
 
 
+def test_a_merge_of_recorded_values_goes_on_a_grid(loop):
+    # op stored at even seconds, pv at odd ones, as an outer join of two tags' recorded values
+    df = loop.copy()
+    df.loc[df.index % 2 == 1, "op"] = np.nan
+    df.loc[(df.index % 2 == 0) & (df.index > 0), "pv"] = np.nan
+    d = stiction.diagnose(df, sp="sp", quantify=False)
+    assert any("stored at their own times" in n for n in d.notes), d.notes
+    assert d.verdict == stiction.diagnose(loop, sp="sp", quantify=False).verdict
+
+
 def test_models_and_simulate():
     op = np.sin(np.linspace(0, 20, 500))
     mv = stiction.Stenman(d=0.5).simulate(op)

@@ -305,6 +305,61 @@ fn historian_states_in_a_few_cells_are_bridged_not_a_split() {
 }
 
 #[test]
+fn a_merge_of_recorded_values_is_put_on_a_grid() {
+    // a historian stores OP and PV each on change (past 0.05), and the export of both tags puts
+    // them on the union of their times: most rows hold one and leave the other blank. Read as
+    // gaps, the blanks cut the record into 418 stretches ("insufficient data").
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "loop.csv", "2", &[]);
+    let table = rows(&f);
+    let mut out = String::from("t,sp,op,pv\n");
+    let (mut last_op, mut last_pv) = (f64::NAN, f64::NAN);
+    for r in &table[1..] {
+        let (op, pv): (f64, f64) = (r[2].parse().unwrap(), r[4].parse().unwrap());
+        let store_op = last_op.is_nan() || (op - last_op).abs() > 0.05;
+        let store_pv = last_pv.is_nan() || (pv - last_pv).abs() > 0.05;
+        if store_op {
+            last_op = op;
+        }
+        if store_pv {
+            last_pv = pv;
+        }
+        if store_op || store_pv {
+            let cell = |store: bool, v: f64| {
+                if store {
+                    format!("{v:.4}")
+                } else {
+                    String::new()
+                }
+            };
+            out.push_str(&format!(
+                "{},{},{},{}\n",
+                r[0],
+                r[1],
+                cell(store_op, op),
+                cell(store_pv, pv)
+            ));
+        }
+    }
+    let p = dir.path().join("recorded.csv");
+    std::fs::write(&p, out).unwrap();
+    let p = p.to_str().unwrap();
+    let v = json(&ok(&["diagnose", p, "--sp", "sp", "--json"]));
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    assert_eq!(v["samples"].as_u64(), Some(table.len() as u64 - 1), "{v:#}");
+    let band = v["band"]["band_percent_of_span"].as_f64().unwrap();
+    assert!((band - 2.0).abs() < 0.3, "band {band}");
+    let human = ok(&["diagnose", p, "--sp", "sp", "--no-quantify"]);
+    assert!(
+        human.contains(
+            "the signals are stored at their own times (a merge of a historian's recorded values"
+        ) && human.contains("onto a grid every 1 s"),
+        "{human}"
+    );
+    assert!(!human.contains("treated as missing"), "{human}");
+}
+
+#[test]
 fn bad_input_is_one_clear_sentence() {
     let dir = tempfile::tempdir().unwrap();
     let f = simulate(dir.path(), "loop.csv", "2", &[]);

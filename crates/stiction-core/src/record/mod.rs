@@ -1,7 +1,9 @@
 //! Preparing a loop record from its columns, as every front end needs it: the CLI from a file's
 //! table, the Python package from a pandas DataFrame or numpy arrays. Gaps are NaN; a row whose
 //! time is missing is a gap and its time is filled in between its neighbours; rows are put in
-//! time order (a row repeating a time dropped); the sampling time is the median step.
+//! time order (a row repeating a time dropped); the sampling time is the median step; a merge of
+//! signals stored at their own times goes on a regular grid (`own_times`); short gaps can be
+//! bridged (`gaps`).
 //!
 //! Pure functions over slices: the signals are borrowed ([`Cow`]) and copied only when a gap in
 //! time or the time order calls for it, so a front end reads its arrays without copies.
@@ -10,9 +12,11 @@ use crate::diagnose::LoopRecord;
 use std::borrow::Cow;
 
 mod gaps;
+mod own_times;
 pub use gaps::{
     bridged, bridged_note, longest_clean, short_gaps, BRIDGE_MAX_RUN, BRIDGE_MAX_SHARE,
 };
+pub use own_times::OWN_TIMES_SHARE;
 
 /// The signals of one loop, as columns (gaps NaN; `auto` `true` where the controller is in
 /// automatic; `time` in seconds).
@@ -68,8 +72,12 @@ pub struct Prepared<'a> {
     pub ts: f64,
     /// What a person should know (rows sorted, repeated times dropped, no time values).
     pub notes: Vec<String>,
-    /// The input row of each sample, when the rows were sorted by time (else sample k is row k).
+    /// The input row of each sample, when the rows were sorted by time or put on a grid (else
+    /// sample k is row k).
     pub rows: Option<Vec<usize>>,
+    /// Whether the signals were stored at their own times and put on a regular grid (their
+    /// blank cells then stand for "nothing stored here", not for missing data).
+    pub on_grid: bool,
 }
 
 /// Why a record cannot be prepared.
@@ -112,7 +120,8 @@ fn check_lengths(s: &Signals) -> Result<(), PrepareError> {
 
 /// Prepare a record: a sample without its time becomes a gap (its time filled in), rows are put
 /// in time order, and the sampling time is `ts` if given, else the median step of the time,
-/// else 1 s.
+/// else 1 s. A record whose signals were stored at their own times (most rows partly blank: a
+/// merge of a historian's recorded values) is put on a regular grid every `ts` seconds.
 pub fn prepare<'a>(mut s: Signals<'a>, ts: Option<f64>) -> Result<Prepared<'a>, PrepareError> {
     if let Some(ts) = ts {
         if !(ts > 0.0 && ts.is_finite()) {
@@ -144,11 +153,24 @@ pub fn prepare<'a>(mut s: Signals<'a>, ts: Option<f64>) -> Result<Prepared<'a>, 
         (None, Some(t)) => sampling_time(t).ok_or(PrepareError::TimeNotIncreasing)?,
         (None, None) => 1.0,
     };
+    let mut on_grid = false;
+    if let Some(blank) = own_times::stored_at_own_times(&s) {
+        if let Some((grid, grid_rows)) = own_times::on_grid(&s, ts) {
+            notes.push(own_times::note(&blank, s.op.len(), grid.op.len(), ts));
+            rows = Some(match &rows {
+                Some(keep) => grid_rows.iter().map(|&r| keep[r]).collect(),
+                None => grid_rows,
+            });
+            s = grid;
+            on_grid = true;
+        }
+    }
     Ok(Prepared {
         signals: s,
         ts,
         notes,
         rows,
+        on_grid,
     })
 }
 
