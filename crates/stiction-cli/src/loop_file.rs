@@ -337,6 +337,12 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
     })?;
     notes.extend(p.notes);
     let on_grid = p.on_grid;
+    if p.setpoint_held {
+        // the setpoint's blanks were between stored values (the core's note says so)
+        if let Some(c) = s.sp.and_then(|c| table.find(c)) {
+            missing.retain(|(name, _)| *name != table.headers[c]);
+        }
+    }
     let v = p.signals;
     Ok(LoopFile {
         op: v.op.into_owned(),

@@ -208,7 +208,12 @@ fn held_op(dir: &Path, name: &str, op: f64) -> std::path::PathBuf {
 
 /// A copy of the CSV at `path`, named `name`, with column `column` rewritten by `edit` (the
 /// row, from 1 after the header, and the cell).
-fn edited(path: &str, name: &str, column: &str, edit: impl Fn(usize, &str) -> String) -> String {
+fn edited(
+    path: &str,
+    name: &str,
+    column: &str,
+    mut edit: impl FnMut(usize, &str) -> String,
+) -> String {
     let raw = std::fs::read_to_string(path).unwrap();
     let mut lines = raw.lines();
     let header = lines.next().unwrap();
@@ -354,6 +359,32 @@ fn a_merge_of_recorded_values_is_put_on_a_grid() {
         human.contains(
             "the signals are stored at their own times (a merge of a historian's recorded values"
         ) && human.contains("onto a grid every 1 s"),
+        "{human}"
+    );
+    assert!(!human.contains("treated as missing"), "{human}");
+}
+
+#[test]
+fn a_setpoint_stored_only_when_it_changes_is_held() {
+    // step tags are exported with the value only where it changes; read as gaps, every row but
+    // those was unusable ("the longest usable stretch has 1 samples")
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "loop.csv", "2", &[]);
+    let mut last = String::new();
+    let p = edited(&f, "sp_on_change.csv", "sp", |_, v| {
+        if v == last {
+            String::new()
+        } else {
+            last = v.to_string();
+            v.into()
+        }
+    });
+    let v = json(&ok(&["diagnose", &p, "--sp", "sp", "--json"]));
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    let human = ok(&["diagnose", &p, "--sp", "sp", "--no-quantify"]);
+    assert!(
+        human.contains("the setpoint is stored only when it changes (")
+            && human.contains("each value is held until the next"),
         "{human}"
     );
     assert!(!human.contains("treated as missing"), "{human}");

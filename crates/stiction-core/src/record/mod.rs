@@ -78,6 +78,9 @@ pub struct Prepared<'a> {
     /// Whether the signals were stored at their own times and put on a regular grid (their
     /// blank cells then stand for "nothing stored here", not for missing data).
     pub on_grid: bool,
+    /// Whether the setpoint was stored only when it changed, and each value was held until the
+    /// next (its blank cells are not missing data).
+    pub setpoint_held: bool,
 }
 
 /// Why a record cannot be prepared.
@@ -165,12 +168,26 @@ pub fn prepare<'a>(mut s: Signals<'a>, ts: Option<f64>) -> Result<Prepared<'a>, 
             on_grid = true;
         }
     }
+    let mut setpoint_held = false;
+    if let (false, Some(blank)) = (on_grid, own_times::setpoint_on_change(&s)) {
+        if let Some(sp) = s.sp.as_mut() {
+            let stored = sp.len() - blank;
+            *sp = Cow::Owned(own_times::held(sp));
+            notes.push(format!(
+                "the setpoint is stored only when it changes ({} blank between {}): each value is held until the next",
+                count(blank, "cell", "cells"),
+                count(stored, "stored value", "stored values")
+            ));
+            setpoint_held = true;
+        }
+    }
     Ok(Prepared {
         signals: s,
         ts,
         notes,
         rows,
         on_grid,
+        setpoint_held,
     })
 }
 

@@ -103,11 +103,11 @@ pub(super) fn on_grid(s: &Signals, ts: f64) -> Option<(Signals<'static>, Vec<usi
         rows.push(r);
     }
     let line = |v: &[f64]| interpolated(t, v, &grid);
-    let held = |v: &[f64]| rows.iter().map(|&r| held_at(v, r)).collect::<Vec<f64>>();
+    let held_sp = |v: &[f64]| rows.iter().map(|&r| held_at(v, r)).collect::<Vec<f64>>();
     let signals = Signals {
         op: Cow::Owned(line(&s.op)),
         pv: Cow::Owned(line(&s.pv)),
-        sp: s.sp.as_deref().map(|v| Cow::Owned(held(v))),
+        sp: s.sp.as_deref().map(|v| Cow::Owned(held_sp(v))),
         mv: s.mv.as_deref().map(|v| Cow::Owned(line(v))),
         auto: s
             .auto
@@ -156,6 +156,32 @@ fn interpolated(t: &[f64], v: &[f64], grid: &[f64]) -> Vec<f64> {
     out
 }
 
+/// The blank cells of a setpoint stored only when it changes (a step tag, as historians and
+/// hand-made sheets keep it): blank in at least [`OWN_TIMES_SHARE`] of the rows where OP and PV
+/// are present, and stored at least once.
+pub(super) fn setpoint_on_change(s: &Signals) -> Option<usize> {
+    let sp = s.sp.as_deref()?;
+    let n = sp.len();
+    let blank = (0..n)
+        .filter(|&k| !sp[k].is_finite() && s.op[k].is_finite() && s.pv[k].is_finite())
+        .count();
+    let stored = sp.iter().filter(|x| x.is_finite()).count();
+    (stored > 0 && n > 0 && blank as f64 >= OWN_TIMES_SHARE * n as f64).then(|| n - stored)
+}
+
+/// `v` with each stored value held until the next (blank before the first).
+pub(super) fn held(v: &[f64]) -> Vec<f64> {
+    let mut last = f64::NAN;
+    v.iter()
+        .map(|&x| {
+            if x.is_finite() {
+                last = x;
+            }
+            last
+        })
+        .collect()
+}
+
 /// The note for a record put on the grid.
 pub(super) fn note(blank: &[(&str, usize)], rows: usize, samples: usize, ts: f64) -> String {
     let which: Vec<String> = blank.iter().map(|(n, k)| format!("{n} {k}")).collect();
@@ -189,6 +215,9 @@ mod tests {
         assert_eq!(interpolated(&t, &v, &t)[42], 42.0);
         assert_eq!(held_at(&[1.0, f64::NAN, 3.0, f64::NAN], 3), 3.0);
         assert!(held_at(&[f64::NAN, 2.0], 0).is_nan());
+        let h = held(&[f64::NAN, 1.0, f64::NAN, f64::NAN, 3.0, f64::NAN]);
+        assert!(h[0].is_nan());
+        assert_eq!(&h[1..], &[1.0, 1.0, 1.0, 3.0, 3.0]);
     }
 
     #[test]
@@ -221,6 +250,19 @@ mod tests {
         assert!(g.op[n - 1].is_nan(), "past op's last stored value");
         assert_eq!(g.pv[2], 4.0);
         assert_eq!(rows[7], 7);
+        // a setpoint stored only when it changes, beside dense OP and PV
+        let sp: Vec<f64> = (0..n)
+            .map(|k| match k {
+                0 => 50.0,
+                20 => 51.0,
+                _ => f64::NAN,
+            })
+            .collect();
+        let mut s4 = Signals::new(&t, &t);
+        s4.sp = Some(Cow::Borrowed(&sp));
+        assert_eq!(setpoint_on_change(&s4), Some(n - 2));
+        s4.sp = Some(Cow::Borrowed(&t));
+        assert_eq!(setpoint_on_change(&s4), None);
         // an outage (one long blank run on a regular time axis) is not a merge
         let mut pv3 = t.clone();
         pv3[10..30].fill(f64::NAN);
