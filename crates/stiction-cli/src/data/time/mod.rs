@@ -150,7 +150,14 @@ pub fn parse_column(
             let (lo, hi) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
                 (l.min(x), h.max(x))
             });
-            if lo >= 1e11 && hi < 1e14 {
+            if looks_like_excel_days(&v, lo, hi) {
+                axis.local = true;
+                axis.notes.push(
+                    "the time column is read as Excel serial days, as a spreadsheet stores dates (its values lie between 20,000 and 80,000 and step by less than 0.01: as seconds that would be sampling faster than 100 Hz); give --time-format seconds if they are seconds"
+                        .into(),
+                );
+                excel_days(cells, missing, spec.tz.as_ref(), &mut axis.notes)?
+            } else if lo >= 1e11 && hi < 1e14 {
                 // seconds past 1e11 would be the year 5138: these are epoch milliseconds
                 axis.notes.push(
                     "the time column is read as milliseconds since 1970 (its values are past 1e11); \
@@ -171,6 +178,23 @@ pub fn parse_column(
         check_repeats(&axis.seconds)?;
     }
     Ok(axis)
+}
+
+/// Numbers between 20,000 and 80,000 (Excel serial days of the years 1954 to 2119) whose median
+/// step is under 0.01: as seconds that would be sampling faster than 100 Hz, which no historian
+/// export holds; as days it is under 15 minutes.
+fn looks_like_excel_days(v: &[f64], lo: f64, hi: f64) -> bool {
+    if !(lo >= 20_000.0 && hi <= 80_000.0) {
+        return false;
+    }
+    let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    let mut steps: Vec<f64> = finite
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .filter(|s| *s > 0.0)
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    steps.get(steps.len() / 2).is_some_and(|&s| s < 0.01)
 }
 
 fn numbers(

@@ -121,3 +121,27 @@ fn no_text_panics_and_unknown_forms_name_the_row() {
         Err(TimeError::Cell { row: 1, .. })
     ));
 }
+
+#[test]
+fn excel_serial_days_are_found_without_being_named() {
+    // a spreadsheet's dates as numbers: read as seconds, they gave "2000 samples at 0.000012 s"
+    let a = parse(
+        &["45352.5", "45352.5000578704", "45352.5001157407"],
+        &TimeSpec::default(),
+    )
+    .unwrap();
+    assert_eq!(a.seconds[0], 1_709_294_400.0);
+    assert!(
+        (a.seconds[2] - a.seconds[0] - 10.0).abs() < 1e-3,
+        "{:?}",
+        a.seconds
+    );
+    assert!(a
+        .notes
+        .iter()
+        .any(|n| n.contains("read as Excel serial days")));
+    // plain seconds in that range, stepping by a second or more, stay seconds
+    let b = parse(&["45352", "45353", "45354"], &TimeSpec::default()).unwrap();
+    assert_eq!(b.seconds, vec![45352.0, 45353.0, 45354.0]);
+    assert!(b.notes.is_empty());
+}
