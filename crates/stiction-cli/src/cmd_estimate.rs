@@ -112,6 +112,7 @@ pub fn run(a: Args) -> Result<()> {
     let req = req.check().map_err(spec::setting_error)?;
 
     let table = a.reading.open(&a.file)?;
+    let table = table.with_header_naming(&[&a.op, &a.mv]).unwrap_or(table);
     let spec = a.reading.time_spec()?;
     let pair = data::read_pair(
         &table,

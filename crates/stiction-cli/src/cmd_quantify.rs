@@ -80,6 +80,7 @@ pub struct Args {
 pub fn run(a: Args) -> Result<()> {
     let (kind, method) = a.fit.resolve()?;
     let table = a.reading.open(&a.file)?;
+    let table = table.with_header_naming(&[&a.op, &a.pv]).unwrap_or(table);
     let name = table.path.display().to_string();
     let signals = Signals {
         mv: None,

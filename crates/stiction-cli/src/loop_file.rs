@@ -194,9 +194,23 @@ pub struct Signals<'a> {
 }
 
 impl Columns {
-    /// Read the file these columns come from (with `--sheet`).
+    /// Read the file these columns come from (with `--sheet`), its header found below a
+    /// preamble if need be ([`Table::with_header_naming`]).
     pub fn open(&self, path: &Path) -> Result<Table> {
-        self.reading.open(path)
+        let t = self.reading.open(path)?;
+        Ok(t.with_header_naming(&self.wanted()).unwrap_or(t))
+    }
+
+    /// The columns these flags name.
+    fn wanted(&self) -> Vec<&str> {
+        let mut w = vec![self.op.as_str(), self.pv.as_str()];
+        w.extend(
+            [&self.sp, &self.mv, &self.mode, &self.time]
+                .into_iter()
+                .flatten()
+                .map(String::as_str),
+        );
+        w
     }
 
     pub fn read(&self, table: &Table) -> Result<LoopFile> {
@@ -217,7 +231,11 @@ impl Columns {
             time: self.time.as_deref(),
             ts: self.ts,
         };
-        read_loop(table, &signals, &self.reading.time_spec()?)
+        let spec = self.reading.time_spec()?;
+        match table.with_header_naming(&self.wanted()) {
+            Some(t) => read_loop(&t, &signals, &spec),
+            None => read_loop(table, &signals, &spec),
+        }
     }
 
     /// The column names as a loop's page shows them in its header.
@@ -303,7 +321,7 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
         }
         None => None,
     };
-    let mut notes = Vec::new();
+    let mut notes = table.notes.clone();
     let time_col = data::time_column(table, s.time)?;
     let time = match time_col {
         Some(c) => {

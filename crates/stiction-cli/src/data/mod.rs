@@ -183,9 +183,10 @@ pub fn read_pair(
             table.headers[a]
         );
     }
+    let notes: Vec<String> = table.notes.iter().cloned().chain(s.note).collect();
     Ok(Pair {
         a: av,
         b: s.columns[1][s.start..s.end].to_vec(),
-        note: s.note,
+        note: (!notes.is_empty()).then(|| notes.join("; ")),
     })
 }

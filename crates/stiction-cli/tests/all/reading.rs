@@ -307,6 +307,42 @@ fn utf16_text_and_excel_sep_lines_are_read() {
 }
 
 #[test]
+fn a_header_below_a_preamble_or_above_units_is_found() {
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, _) = sticky(dir.path());
+    let reference = band(&[s(&csv)]);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let (header, body) = text.split_once('\n').unwrap();
+    // PI DataLink style: tag names and units above the header
+    let pre = dir.path().join("preamble.csv");
+    let width = header.split(',').count();
+    let tags = vec!["Tag"; width].join(",");
+    let units = vec!["Units"; width].join(",");
+    std::fs::write(&pre, format!("{tags}\n{units}\n{header}\n{body}")).unwrap();
+    assert_eq!(band(&[s(&pre)]), reference);
+    let out = ok(&["diagnose", s(&pre), "--no-quantify"]);
+    assert!(
+        out.contains("the header is line 3, below 2 lines the export put above it (Tag, "),
+        "{out}"
+    );
+    // units below the header
+    let below = dir.path().join("units.csv");
+    let units = vec!["%"; width].join(",");
+    std::fs::write(&below, format!("{header}\n{units}\n{body}")).unwrap();
+    assert_eq!(band(&[s(&below)]), reference);
+    let out = ok(&["diagnose", s(&below), "--no-quantify"]);
+    assert!(
+        out.contains("1 line of text below the header (%, %, %"),
+        "{out}"
+    );
+    // no row names the columns: the error names them as before
+    fails(
+        &["quantify", s(&pre), "--op", "OUT"],
+        &["no column 'OUT'", "the columns are Tag"],
+    );
+}
+
+#[test]
 fn crlf_files_name_the_right_line() {
     // Windows programs end lines with CRLF; the csv reader's own count ran one line short there
     let dir = tempfile::tempdir().unwrap();
