@@ -71,17 +71,19 @@ fn parse_modes(cells: Vec<Option<String>>) -> (Vec<bool>, Option<usize>) {
 }
 
 /// Text cells as numbers, as the CLI reads a file's cells: missing cells (blank, NaN, #N/A,
-/// historian states such as Bad Input; `None`) are NaN, a decimal comma reads as a point.
+/// historian states such as Bad Input; `None`) are NaN, a decimal comma reads as a point, and
+/// digits grouped by thousands read with the convention the column shows.
 /// Returns the values and the index of the first cell that is not a finite number, if any.
 #[pyfunction]
 fn parse_numbers(cells: Vec<Option<String>>) -> (Vec<f64>, Option<usize>) {
-    use stiction_core::record::{is_missing, parse_number};
+    use stiction_core::record::{is_missing, parse_number_grouped, Grouping};
+    let grouping = Grouping::of(cells.iter().flatten().map(|c| c.trim()));
     let mut out = Vec::with_capacity(cells.len());
     for (k, c) in cells.iter().enumerate() {
         let v = match c.as_deref() {
             None => f64::NAN,
             Some(c) if is_missing(c) => f64::NAN,
-            Some(c) => match parse_number(c.trim()).filter(|v| v.is_finite()) {
+            Some(c) => match parse_number_grouped(c.trim(), grouping).filter(|v| v.is_finite()) {
                 Some(v) => v,
                 None => return (out, Some(k)),
             },

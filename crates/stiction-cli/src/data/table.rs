@@ -6,6 +6,7 @@ use super::time::{self, TimeAxis, TimeError, TimeSpec};
 use super::ReadOptions;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
+use stiction_core::record::{parse_number_grouped, Grouping};
 
 /// A data file read as text: header names and rows of cells.
 pub struct Table {
@@ -251,6 +252,8 @@ impl Table {
         let name = &self.headers[col];
         let file = self.path.display();
         let mut out = Vec::with_capacity(self.len());
+        // digits grouped by thousands: the convention the column's unambiguous cells show
+        let grouping = Grouping::of((0..self.len()).map(|i| self.cell(i, col)));
         for i in 0..self.len() {
             let cell = self.cell(i, col);
             if is_missing(cell) {
@@ -258,7 +261,7 @@ impl Table {
                 continue;
             }
             // a decimal comma (European historian exports, semicolon separated) reads as a point
-            let v = super::parse_number(cell).with_context(|| {
+            let v = parse_number_grouped(cell, grouping).with_context(|| {
                 format!(
                     "{file}: {}, column '{name}': '{}' is not a number; use plain decimal numbers such as 12.5 \
                      (blank cells, NaN, #N/A and historian states such as Bad Input are read as gaps)",

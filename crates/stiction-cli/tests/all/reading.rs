@@ -343,6 +343,50 @@ fn a_header_below_a_preamble_or_above_units_is_found() {
 }
 
 #[test]
+fn digits_grouped_by_thousands_are_read() {
+    // PV in kg/h as spreadsheets format it: "4,999.94" (or "4.999,94" with semicolons); a lone
+    // "12,345" in such a column is twelve thousand
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, rows) = sticky(dir.path());
+    let reference = band(&[s(&csv)]);
+    let grouped = |v: f64, comma: bool| {
+        let cents = (v * 10_000.0).round() as i64; // PV x 100, two decimals
+        let (int, frac) = (cents / 100, cents % 100);
+        let t = int.to_string();
+        let mut g = String::new();
+        for (k, ch) in t.chars().enumerate() {
+            if k > 0 && (t.len() - k) % 3 == 0 {
+                g.push(if comma { ',' } else { '.' });
+            }
+            g.push(ch);
+        }
+        format!("{g}{}{frac:02}", if comma { '.' } else { ',' })
+    };
+    for (name, comma, sep) in [("us.csv", true, ","), ("eu.csv", false, ";")] {
+        let mut out = format!("t{sep}op{sep}pv\n");
+        for r in &rows {
+            let op = if comma {
+                r[2].to_string()
+            } else {
+                r[2].to_string().replace('.', ",")
+            };
+            out.push_str(&format!(
+                "{}{sep}{op}{sep}\"{}\"\n",
+                r[0],
+                grouped(r[4], comma)
+            ));
+        }
+        let p = dir.path().join(name);
+        std::fs::write(&p, out).unwrap();
+        let d = band(&[s(&p)]);
+        assert!(
+            (d - reference).abs() < 0.01 * reference,
+            "{name}: {d} vs {reference}"
+        );
+    }
+}
+
+#[test]
 fn crlf_files_name_the_right_line() {
     // Windows programs end lines with CRLF; the csv reader's own count ran one line short there
     let dir = tempfile::tempdir().unwrap();

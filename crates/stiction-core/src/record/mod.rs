@@ -12,10 +12,12 @@ use crate::diagnose::LoopRecord;
 use std::borrow::Cow;
 
 mod gaps;
+mod numbers;
 mod own_times;
 pub use gaps::{
     bridged, bridged_note, longest_clean, short_gaps, BRIDGE_MAX_RUN, BRIDGE_MAX_SHARE,
 };
+pub use numbers::{parse_number, parse_number_grouped, Grouping};
 pub use own_times::OWN_TIMES_SHARE;
 
 /// The signals of one loop, as columns (gaps NaN; `auto` `true` where the controller is in
@@ -347,15 +349,6 @@ pub const MISSING_MARKERS: &[&str] = &[
 pub fn is_missing(cell: &str) -> bool {
     let c = cell.trim();
     c.len() <= 13 && MISSING_MARKERS.iter().any(|m| m.eq_ignore_ascii_case(c))
-}
-
-/// A number with a decimal point, or with a decimal comma and no point (`12,5`).
-pub fn parse_number(cell: &str) -> Option<f64> {
-    cell.parse().ok().or_else(|| {
-        (cell.matches(',').count() == 1 && !cell.contains('.'))
-            .then(|| cell.replace(',', ".").parse().ok())
-            .flatten()
-    })
 }
 
 /// A controller mode cell in words: `Some(true)` for automatic (auto, automatic, aut, a, 1, true,
