@@ -112,7 +112,11 @@ pub fn run(a: Args) -> Result<()> {
     let req = req.check().map_err(spec::setting_error)?;
 
     let table = a.reading.open(&a.file)?;
-    let table = table.with_header_naming(&[&a.op, &a.mv]).unwrap_or(table);
+    let mut wanted = vec![a.op.as_str(), a.mv.as_str()];
+    wanted.extend(a.time.as_deref());
+    let table = table
+        .for_columns(&wanted, &[&a.op, &a.mv], a.time.as_deref())
+        .unwrap_or(table);
     let spec = a.reading.time_spec()?;
     let pair = data::read_pair(
         &table,

@@ -80,7 +80,11 @@ pub struct Args {
 pub fn run(a: Args) -> Result<()> {
     let (kind, method) = a.fit.resolve()?;
     let table = a.reading.open(&a.file)?;
-    let table = table.with_header_naming(&[&a.op, &a.pv]).unwrap_or(table);
+    let mut wanted = vec![a.op.as_str(), a.pv.as_str()];
+    wanted.extend(a.time.as_deref());
+    let table = table
+        .for_columns(&wanted, &[&a.op, &a.pv], a.time.as_deref())
+        .unwrap_or(table);
     let name = table.path.display().to_string();
     let signals = Signals {
         mv: None,

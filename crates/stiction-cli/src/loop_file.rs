@@ -194,23 +194,25 @@ pub struct Signals<'a> {
 }
 
 impl Columns {
-    /// Read the file these columns come from (with `--sheet`), its header found below a
-    /// preamble if need be ([`Table::with_header_naming`]).
+    /// Read the file these columns come from (with `--sheet`), laid out so that they are
+    /// named if need be (a header below a preamble, a narrow export: [`Table::for_columns`]).
     pub fn open(&self, path: &Path) -> Result<Table> {
         let t = self.reading.open(path)?;
-        Ok(t.with_header_naming(&self.wanted()).unwrap_or(t))
+        Ok(self.laid_out(&t).unwrap_or(t))
     }
 
-    /// The columns these flags name.
-    fn wanted(&self) -> Vec<&str> {
-        let mut w = vec![self.op.as_str(), self.pv.as_str()];
-        w.extend(
-            [&self.sp, &self.mv, &self.mode, &self.time]
+    /// `table` laid out so that these columns are named ([`Table::for_columns`]), if need be.
+    fn laid_out(&self, table: &Table) -> Option<Table> {
+        let mut signals = vec![self.op.as_str(), self.pv.as_str()];
+        signals.extend(
+            [&self.sp, &self.mv, &self.mode]
                 .into_iter()
                 .flatten()
                 .map(String::as_str),
         );
-        w
+        let mut wanted = signals.clone();
+        wanted.extend(self.time.as_deref());
+        table.for_columns(&wanted, &signals, self.time.as_deref())
     }
 
     pub fn read(&self, table: &Table) -> Result<LoopFile> {
@@ -232,7 +234,7 @@ impl Columns {
             ts: self.ts,
         };
         let spec = self.reading.time_spec()?;
-        match table.with_header_naming(&self.wanted()) {
+        match self.laid_out(table) {
             Some(t) => read_loop(&t, &signals, &spec),
             None => read_loop(table, &signals, &spec),
         }

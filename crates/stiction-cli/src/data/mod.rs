@@ -5,6 +5,7 @@
 //! file, the column and the line.
 
 mod format;
+mod layout;
 mod missing;
 #[cfg(feature = "parquet")]
 mod parquet;

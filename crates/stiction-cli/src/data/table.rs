@@ -19,9 +19,9 @@ pub struct Table {
     spans: Vec<(usize, usize)>,
     /// Line (text files) or row (sheets, Parquet) number of each row; the header is 1 in a
     /// text file.
-    lines: Vec<u64>,
+    pub(super) lines: Vec<u64>,
     /// What a row is called in messages: "line" or "row".
-    row_word: &'static str,
+    pub(super) row_word: &'static str,
     /// The sheet read from a workbook ...
     pub sheet: Option<String>,
     /// ... and every sheet it has.
@@ -29,9 +29,6 @@ pub struct Table {
     /// What reading decided that a person should know (a header found below a preamble).
     pub notes: Vec<String>,
 }
-
-/// Rows searched for a header below a preamble.
-pub const HEADER_SEARCH: usize = 20;
 
 impl Table {
     /// An empty table with these headers; rows are added with [`Table::push_row`].
@@ -73,90 +70,6 @@ impl Table {
         }
         self.spans.resize(start + self.headers.len(), (0, 0));
         self.lines.push(line);
-    }
-
-    /// The table with its header where the `wanted` columns are named: when the header lacks
-    /// some but one of the first [`HEADER_SEARCH`] rows names them all (a preamble of tag names,
-    /// descriptions or units above the real header, as PI DataLink and other exports write),
-    /// that row becomes the header and the rows above it are left out; rows of text right below
-    /// the header (units, descriptions) are left out too. With a note; `None` when there is
-    /// nothing to change (or no row names them all).
-    pub fn with_header_naming(&self, wanted: &[&str]) -> Option<Table> {
-        let names =
-            |i: usize| -> Vec<&str> { (0..self.headers.len()).map(|c| self.cell(i, c)).collect() };
-        let at = if wanted.iter().all(|w| self.find(w).is_some()) {
-            None
-        } else {
-            Some((0..self.len().min(HEADER_SEARCH)).find(|&i| {
-                let row = names(i);
-                wanted
-                    .iter()
-                    .all(|w| row.iter().any(|c| c.eq_ignore_ascii_case(w.trim())))
-            })?)
-        };
-        // units or descriptions: text, but no number and no missing value (a data row whose
-        // values are all historian states stays)
-        let text_only = |i: usize| {
-            let row = names(i);
-            row.iter().any(|c| !c.is_empty())
-                && row.iter().all(|c| {
-                    c.is_empty()
-                        || (stiction_core::record::parse_number(c).is_none()
-                            && !stiction_core::record::is_missing(c))
-                })
-        };
-        let below = at.map_or(0, |a| a + 1);
-        let mut first = below;
-        while first < self.len() && first < below + 3 && text_only(first) {
-            first += 1;
-        }
-        if at.is_none() && first == 0 {
-            return None;
-        }
-        let headers: Vec<String> = match at {
-            Some(a) => names(a).iter().map(|c| c.to_string()).collect(),
-            None => self.headers.clone(),
-        };
-        let mut t = Table::new(&self.path, headers);
-        t.row_word = self.row_word;
-        t.sheet = self.sheet.clone();
-        t.sheets = self.sheets.clone();
-        for i in first..self.len() {
-            t.push_row(names(i), self.lines[i]);
-        }
-        let lines = |k: usize| match k {
-            1 => "1 line".to_string(),
-            k => format!("{k} lines"),
-        };
-        let shown = |i: usize| names(i).join(", ").chars().take(40).collect::<String>();
-        let mut said = Vec::new();
-        if let Some(a) = at {
-            let above: Vec<String> = std::iter::once(self.headers.join(", "))
-                .chain((0..a).map(shown))
-                .map(|l| l.chars().take(40).collect())
-                .collect();
-            said.push(format!(
-                "the header is {}, below {} the export put above it ({}), left out",
-                self.at(a),
-                lines(a + 1),
-                above.join("; ")
-            ));
-        }
-        if first > below {
-            let text: Vec<String> = (below..first).map(shown).collect();
-            said.push(format!(
-                "{} of text below the header ({}: units or descriptions) left out",
-                lines(first - below),
-                text.join("; ")
-            ));
-        }
-        let mut note = said.join("; ");
-        if self.row_word == "row" {
-            note = note.replace(" line", " row");
-        }
-        t.notes = self.notes.clone();
-        t.notes.push(note);
-        Some(t)
     }
 
     /// Read a file (`-`: standard input) in any format this tool reads, found from its bytes,
@@ -222,10 +135,17 @@ impl Table {
     /// The column `name`, or an error naming the flag that chooses it.
     pub fn require(&self, name: &str, flag: &str, role: &str) -> Result<usize> {
         self.find(name).with_context(|| {
+            // a narrow export (tag, time, value): the flags name tags, not columns
+            let narrow = self.find("value").is_some() && self.headers.len() <= 4;
             format!(
-                "{}: no column '{name}' for the {role}; the columns are {}. Name the right one with {flag} COLUMN",
+                "{}: no column '{name}' for the {role}; the columns are {}. Name the right one with {flag} {}",
                 self.path.display(),
-                self.headers.join(", ")
+                self.headers.join(", "),
+                if narrow {
+                    "TAG (the file looks narrow, a row per tag and time: give each signal's tag as it appears in the file, e.g. --op FIC101.OP --pv FIC101.PV)"
+                } else {
+                    "COLUMN"
+                }
             )
         })
     }

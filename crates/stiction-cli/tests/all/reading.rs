@@ -387,6 +387,47 @@ fn digits_grouped_by_thousands_are_read() {
 }
 
 #[test]
+fn a_narrow_export_is_pivoted_by_the_tags_named() {
+    // a row per tag and time, as historians export archive values
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, rows) = sticky(dir.path());
+    let reference = band(&[s(&csv)]);
+    let mut out = String::from("Tag,Timestamp,Value\n");
+    for r in &rows {
+        for (tag, k) in [("FIC101.OP", 2), ("FIC101.PV", 4), ("LIC7.PV", 4)] {
+            out.push_str(&format!("{tag},{},{}\n", r[0], r[k]));
+        }
+    }
+    let p = dir.path().join("narrow.csv");
+    std::fs::write(&p, out).unwrap();
+    let tags = [
+        "--op",
+        "fic101.op",
+        "--pv",
+        "FIC101.PV",
+        "--time",
+        "Timestamp",
+    ];
+    let mut args = vec![s(&p)];
+    args.extend(tags);
+    assert_eq!(band(&args), reference);
+    let mut diagnose = vec!["diagnose", s(&p), "--no-quantify"];
+    diagnose.extend(tags);
+    let text = ok(&diagnose);
+    assert!(
+        text.contains(
+            "the file is narrow (a row per tag and time: columns Tag, Timestamp and Value)"
+        ) && text.contains("values of FIC101.OP, FIC101.PV turned into a column per tag at"),
+        "{text}"
+    );
+    // without the tags: one sentence saying to name them
+    fails(
+        &["diagnose", s(&p)],
+        &["no column 'op'", "the file looks narrow", "--op FIC101.OP"],
+    );
+}
+
+#[test]
 fn crlf_files_name_the_right_line() {
     // Windows programs end lines with CRLF; the csv reader's own count ran one line short there
     let dir = tempfile::tempdir().unwrap();
