@@ -428,6 +428,44 @@ fn a_narrow_export_is_pivoted_by_the_tags_named() {
 }
 
 #[test]
+fn a_date_and_a_time_column_are_read_together() {
+    // spreadsheets often split the timestamp in two; the times cross midnight
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, rows) = sticky(dir.path());
+    let reference = band(&[s(&csv)]);
+    let stamp = |k: usize| {
+        let s = 23 * 3600 + 50 * 60 + k; // from 23:50:00 on 1 March 2024
+        let (day, s) = (1 + s / 86_400, s % 86_400);
+        (
+            format!("{day:02}.03.2024"),
+            format!("{:02}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60),
+        )
+    };
+    let mut two = String::from("Date,Time,op,pv\n");
+    let mut one = String::from("Time,op,pv\n");
+    for (k, r) in rows.iter().enumerate() {
+        let (d, t) = stamp(k);
+        two.push_str(&format!("{d},{t},{},{}\n", r[2], r[4]));
+        one.push_str(&format!("{t},{},{}\n", r[2], r[4]));
+    }
+    let p = dir.path().join("two.csv");
+    std::fs::write(&p, two).unwrap();
+    assert_eq!(band(&[s(&p)]), reference);
+    let out = ok(&["diagnose", s(&p), "--no-quantify"]);
+    assert!(
+        out.contains("the time is read from the columns 'Date' and 'Time' together"),
+        "{out}"
+    );
+    assert!(out.contains("samples at 1 s"), "{out}");
+    // times of day alone roll over at midnight
+    let p = dir.path().join("one.csv");
+    std::fs::write(&p, one).unwrap();
+    assert_eq!(band(&[s(&p)]), reference);
+    let out = ok(&["diagnose", s(&p), "--no-quantify"]);
+    assert!(out.contains("read as one day, past midnight once"), "{out}");
+}
+
+#[test]
 fn crlf_files_name_the_right_line() {
     // Windows programs end lines with CRLF; the csv reader's own count ran one line short there
     let dir = tempfile::tempdir().unwrap();
