@@ -24,7 +24,7 @@ pub struct Args {
     /// Column of the measured valve position
     #[arg(long, default_value = "mv")]
     mv: String,
-    /// Column of time [default: the first of t, time, timestamp, if any]
+    /// Column of time [default: the first of t, time, timestamp, datetime, date and other common names, if any]
     #[arg(long)]
     time: Option<String>,
     #[command(flatten)]

@@ -29,7 +29,7 @@ pub struct Args {
     /// Column of the process variable
     #[arg(long, default_value = "pv")]
     pv: String,
-    /// Column of time (seconds, or dates such as 2024-03-01 12:00:05) [default: the first of t, time, timestamp, if any]
+    /// Column of time (seconds, or dates such as 2024-03-01 12:00:05) [default: the first of t, time, timestamp, datetime, date and other common names, if any]
     #[arg(long)]
     time: Option<String>,
     /// Sampling time in seconds [default: from the time column, else 1]

@@ -90,7 +90,7 @@ pub struct Columns {
     /// reported in % of this span [default: 0:100, OP in %]
     #[arg(long, value_name = "LO:HI", value_parser = parse_op_range)]
     pub op_range: Option<[f64; 2]>,
-    /// Column of time (seconds, or dates such as 2024-03-01 12:00:05) [default: t, time or timestamp if present]
+    /// Column of time (seconds, or dates such as 2024-03-01 12:00:05) [default: the first of t, time, timestamp, datetime, date and other common names, if present]
     #[arg(long)]
     pub time: Option<String>,
     /// Sampling time in seconds [default: the median step of the time column, else 1]

@@ -97,6 +97,7 @@ fn parse_numbers(cells: Vec<Option<String>>) -> (Vec<f64>, Option<usize>) {
 fn _stiction(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("StictionError", m.py().get_type::<StictionError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("TIME_NAMES", stiction_core::record::TIME_NAMES.to_vec())?;
     m.add_function(wrap_pyfunction!(parse_modes, m)?)?;
     m.add_function(wrap_pyfunction!(parse_numbers, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose::diagnose, m)?)?;

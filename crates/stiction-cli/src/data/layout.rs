@@ -109,7 +109,7 @@ impl Table {
     /// A narrow export (a row per tag and time: tag, time and value columns, as historians
     /// export archive values) pivoted to a column per tag, for the `signals` asked for: the tag
     /// column is the one whose cells name every signal, the time column `time` or the first of
-    /// t, time or timestamp, the value column the one named value (or the only other). One row
+    /// the common names (`TIME_NAMES`), the value column the one named value (or the only other). One row
     /// per distinct time, in the order of the file; a tag without a value at a time leaves its
     /// cell blank (a merge the record's preparation puts on a grid). `None` when the table is
     /// not so.
@@ -126,7 +126,7 @@ impl Table {
         })?;
         let time_col = match time {
             Some(name) => self.find(name)?,
-            None => ["t", "time", "timestamp"]
+            None => stiction_core::record::TIME_NAMES
                 .iter()
                 .find_map(|c| self.find(c))?,
         };

@@ -36,11 +36,12 @@ pub struct ReadOptions {
 
 pub(crate) use stiction_core::record::parse_number;
 
-/// The time column: `--time COL` if given, else the first of t, time, timestamp.
+/// The time column: `--time COL` if given, else the first of the common names
+/// (`stiction_core::record::TIME_NAMES`: t, time, timestamp, datetime, date, ...).
 pub fn time_column(table: &Table, explicit: Option<&str>) -> Result<Option<usize>> {
     match explicit {
         Some(name) => table.require(name, "--time", "time").map(Some),
-        None => Ok(["t", "time", "timestamp"]
+        None => Ok(stiction_core::record::TIME_NAMES
             .iter()
             .find_map(|n| table.find(n))),
     }

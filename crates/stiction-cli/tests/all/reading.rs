@@ -466,6 +466,40 @@ fn a_date_and_a_time_column_are_read_together() {
 }
 
 #[test]
+fn time_columns_by_their_common_names_and_a_note_without_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, rows) = sticky(dir.path());
+    let mut dated = String::from("DateTime;op;pv\n");
+    let mut bare = String::from("op,pv\n");
+    for (k, r) in rows.iter().enumerate() {
+        let s = 10 * k; // every 10 s from 01.03.2024 00:00:00
+        dated.push_str(&format!(
+            "01.03.2024 {:02}:{:02}:{:02};{};{}\n",
+            s / 3600,
+            s / 60 % 60,
+            s % 60,
+            r[2],
+            r[4]
+        ));
+        bare.push_str(&format!("{},{}\n", r[2], r[4]));
+    }
+    let p = dir.path().join("dated.csv");
+    std::fs::write(&p, dated).unwrap();
+    let out = ok(&["diagnose", s(&p), "--no-quantify"]);
+    assert!(out.contains("samples at 10 s"), "{out}");
+    assert!(!out.contains("no time column"), "{out}");
+    let p = dir.path().join("bare.csv");
+    std::fs::write(&p, bare).unwrap();
+    let out = ok(&["diagnose", s(&p), "--no-quantify"]);
+    assert!(
+        out.contains(
+            "no time column and no sampling time given: the samples are taken as 1 s apart"
+        ),
+        "{out}"
+    );
+}
+
+#[test]
 fn crlf_files_name_the_right_line() {
     // Windows programs end lines with CRLF; the csv reader's own count ran one line short there
     let dir = tempfile::tempdir().unwrap();

@@ -20,6 +20,22 @@ pub use gaps::{
 pub use numbers::{parse_number, parse_number_grouped, Grouping};
 pub use own_times::OWN_TIMES_SHARE;
 
+/// Column names taken as the time, in this order (any case), when none is named: the common
+/// names of historian and spreadsheet exports.
+pub const TIME_NAMES: &[&str] = &[
+    "t",
+    "time",
+    "timestamp",
+    "time stamp",
+    "datetime",
+    "date time",
+    "date/time",
+    "date",
+    "zeit",
+    "zeitstempel",
+    "datum",
+];
+
 /// The signals of one loop, as columns (gaps NaN; `auto` `true` where the controller is in
 /// automatic; `time` in seconds).
 #[derive(Debug, Clone)]
@@ -156,7 +172,13 @@ pub fn prepare<'a>(mut s: Signals<'a>, ts: Option<f64>) -> Result<Prepared<'a>, 
     let ts = match (ts, s.time.as_deref()) {
         (Some(ts), _) => ts,
         (None, Some(t)) => sampling_time(t).ok_or(PrepareError::TimeNotIncreasing)?,
-        (None, None) => 1.0,
+        (None, None) => {
+            notes.push(
+                "no time column and no sampling time given: the samples are taken as 1 s apart (give the sampling time, or name the time column)"
+                    .into(),
+            );
+            1.0
+        }
     };
     let mut on_grid = false;
     if let Some(blank) = own_times::stored_at_own_times(&s) {

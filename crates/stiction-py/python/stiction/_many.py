@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from . import _stiction as _native
-from ._signals import StictionError, modes, numbers, require, seconds
+from ._signals import TIME_NAMES, StictionError, modes, numbers, require, seconds
 
 #: The columns of ``diagnose_many``'s result, in order: the fleet row of ``stiction batch``'s
 #: summary (the core's ``fleet::Row``).
@@ -123,7 +123,7 @@ def diagnose_many(
     elif isinstance(df.index, pd.DatetimeIndex):
         t, time_name = seconds(df.index[order], "index"), "index"
     else:
-        found = next((c for c in ("t", "time", "timestamp") if c in df.columns and c != by), None)
+        found = next((c for c in TIME_NAMES if c in df.columns and c != by), None)
         if found is not None:
             t, time_name = seconds(df[found].iloc[order], found), found
     names = [str(i) for i in ids]

@@ -16,7 +16,7 @@ from . import _stiction as _native
 
 StictionError = _native.StictionError
 
-TIME_NAMES = ("t", "time", "timestamp")
+TIME_NAMES = tuple(_native.TIME_NAMES)  # stiction_core::record::TIME_NAMES
 
 
 def require(df: pd.DataFrame, name: str, arg: str, role: str) -> pd.Series:
@@ -127,7 +127,7 @@ def loop_columns(
     """The signals of one loop from a DataFrame (column names) or arrays / Series (``data`` None).
 
     The time axis is, in this order: ``time`` (a column name, or an array), a DatetimeIndex of
-    the frame (or of ``op`` when it is a Series), a column t, time or timestamp.
+    the frame (or of ``op`` when it is a Series), a column named as TIME_NAMES lists (t, time, timestamp, datetime, date, ...).
     Returns the arrays and the time column's name (for messages).
     """
     if data is not None:
