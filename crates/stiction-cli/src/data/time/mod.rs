@@ -4,6 +4,7 @@
 //! `jiff`. Local times take their zone from `--tz`, so the hour that repeats when daylight saving
 //! ends and the hour that is skipped when it starts come out right.
 
+mod abbrev;
 mod forms;
 #[cfg(test)]
 mod tests;
@@ -169,10 +170,29 @@ pub fn parse_column(
                 v
             }
         }
-        TimeFormat::Auto => {
-            axis.local = true;
-            auto_text(cells, missing, first, spec.tz.as_ref(), &mut axis.notes)?
-        }
+        TimeFormat::Auto => match abbrev::strip(cells, missing) {
+            // zone abbreviations: each time read as UTC, then moved by its zone's offset
+            Some((stripped, offsets, note)) => {
+                let plain: Vec<&str> = stripped.iter().map(String::as_str).collect();
+                let utc = TimeSpec {
+                    format: TimeFormat::Auto,
+                    tz: Some(TimeZone::UTC),
+                };
+                let mut inner = parse_column(&plain, missing, &utc)?;
+                axis.notes.append(&mut inner.notes);
+                axis.notes.push(note);
+                inner
+                    .seconds
+                    .iter()
+                    .zip(&offsets)
+                    .map(|(s, o)| s - o.unwrap_or(0.0))
+                    .collect()
+            }
+            None => {
+                axis.local = true;
+                auto_text(cells, missing, first, spec.tz.as_ref(), &mut axis.notes)?
+            }
+        },
     };
     if axis.local && spec.tz.is_none() {
         check_repeats(&axis.seconds)?;

@@ -145,3 +145,29 @@ fn excel_serial_days_are_found_without_being_named() {
     assert_eq!(b.seconds, vec![45352.0, 45353.0, 45354.0]);
     assert!(b.notes.is_empty());
 }
+
+#[test]
+fn zone_abbreviations_are_read_with_their_offsets() {
+    // daylight saving ends: 02:59:59 CEST is followed by 02:00:00 CET, one second later
+    let a = auto(&[
+        "2024-10-27 02:59:58 CEST",
+        "2024-10-27 02:59:59 CEST",
+        "2024-10-27 02:00:00 CET",
+    ]);
+    assert_eq!(a[1] - a[0], 1.0);
+    assert_eq!(a[2] - a[1], 1.0);
+    assert_eq!(a[0], 1_729_990_798.0); // 00:59:58 UTC
+                                       // one unknown abbreviation: read alike, the steps right
+    let b = parse(
+        &["2024-03-01 12:00:05 XYZT", "2024-03-01 12:00:15 XYZT"],
+        &TimeSpec::default(),
+    )
+    .unwrap();
+    assert_eq!(b.seconds[1] - b.seconds[0], 10.0);
+    assert!(b.notes.iter().any(|n| n.contains("does not know (XYZT)")));
+    // AM/PM is not a zone
+    assert_eq!(
+        auto(&["03/01/2024 12:00:05 PM", "03/01/2024 12:00:06 PM"]).len(),
+        2
+    );
+}
