@@ -97,12 +97,8 @@ impl Table {
                 text.join("; ")
             ));
         }
-        let mut note = said.join("; ");
-        if self.row_word == "row" {
-            note = note.replace(" line", " row");
-        }
         t.notes = self.notes.clone();
-        t.notes.push(note);
+        t.notes.push(self.row_word.words(said.join("; ")));
         Some(t)
     }
 
@@ -196,10 +192,7 @@ impl Table {
                 }
             ));
         }
-        if self.row_word == "row" {
-            note = note.replace(" line", " row");
-        }
-        t.notes.push(note);
+        t.notes.push(self.row_word.words(note));
         Some(t)
     }
 }

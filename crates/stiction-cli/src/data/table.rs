@@ -8,6 +8,33 @@ use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use stiction_core::record::{parse_number_grouped, Grouping};
 
+/// What a row of a table is called in messages: a line of a text file, a row of a sheet or a
+/// Parquet file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RowWord {
+    Line,
+    Row,
+}
+
+impl std::fmt::Display for RowWord {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            RowWord::Line => "line",
+            RowWord::Row => "row",
+        })
+    }
+}
+
+impl RowWord {
+    /// `text` (written of lines) in these words.
+    pub fn words(self, text: String) -> String {
+        match self {
+            RowWord::Line => text,
+            RowWord::Row => text.replace(" line", " row"),
+        }
+    }
+}
+
 /// A data file read as text: header names and rows of cells.
 pub struct Table {
     pub path: PathBuf,
@@ -20,8 +47,8 @@ pub struct Table {
     /// Line (text files) or row (sheets, Parquet) number of each row; the header is 1 in a
     /// text file.
     pub(super) lines: Vec<u64>,
-    /// What a row is called in messages: "line" or "row".
-    pub(super) row_word: &'static str,
+    /// What a row is called in messages.
+    pub(super) row_word: RowWord,
     /// The sheet read from a workbook ...
     pub sheet: Option<String>,
     /// ... and every sheet it has.
@@ -39,7 +66,7 @@ impl Table {
             text: String::new(),
             spans: Vec::new(),
             lines: Vec::new(),
-            row_word: "line",
+            row_word: RowWord::Line,
             sheet: None,
             sheets: Vec::new(),
             notes: Vec::new(),
@@ -48,7 +75,7 @@ impl Table {
 
     /// Messages call rows "row N" (sheets, Parquet) instead of "line N".
     pub(super) fn rows_are_rows(mut self) -> Table {
-        self.row_word = "row";
+        self.row_word = RowWord::Row;
         self
     }
 
