@@ -284,6 +284,18 @@ fn parse_op_range(text: &str) -> Result<[f64; 2], String> {
     Ok([lo, hi])
 }
 
+/// Blank cells of a mode column take the mode stored before them (in the order of the file).
+fn hold_modes(table: &Table, col: usize, modes: &mut [bool]) {
+    let mut last = false;
+    for (i, m) in modes.iter_mut().enumerate() {
+        if record::is_missing(table.cell(i, col)) {
+            *m = last;
+        } else {
+            last = *m;
+        }
+    }
+}
+
 /// Read a loop record: numbers with gaps as NaN, the time axis in the given form and zone
 /// (missing times filled in between their neighbours, their rows gaps), rows sorted by time.
 pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile> {
@@ -312,18 +324,27 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
     let mv =
         s.mv.map(|c| column(c, "--mv", "valve position mv"))
             .transpose()?;
+    let mut notes = table.notes.clone();
     let auto = match s.mode {
         Some(c) => {
             let col = table.require(c, "--mode", "controller mode")?;
             let k = table.missing(col);
-            if k > 0 {
+            let mut modes = table.modes(col)?;
+            if k < table.len() && k as f64 >= record::OWN_TIMES_SHARE * table.len() as f64 {
+                // a mode stored only when it changes (a step tag): each held until the next
+                hold_modes(table, col, &mut modes);
+                notes.push(format!(
+                    "the mode in column '{}' is stored only when it changes ({} blank): each mode is held until the next (manual before the first)",
+                    table.headers[col],
+                    count(k, "cell", "cells")
+                ));
+            } else if k > 0 {
                 missing.push((table.headers[col].clone(), k));
             }
-            Some(table.modes(col)?)
+            Some(modes)
         }
         None => None,
     };
-    let mut notes = table.notes.clone();
     let time_col = data::time_column(table, s.time)?;
     let time = match time_col {
         Some(c) => {

@@ -391,6 +391,45 @@ fn a_setpoint_stored_only_when_it_changes_is_held() {
 }
 
 #[test]
+fn a_mode_stored_only_when_it_changes_is_held() {
+    // MAN in the first row, AUTO from row 300, blank between, as a step tag is exported; the
+    // blanks were read as manual and left nothing to judge
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "loop.csv", "2", &[]);
+    let table = rows(&f);
+    let mut out = format!("{},mode\n", table[0].join(","));
+    for (k, r) in table[1..].iter().enumerate() {
+        let mode = match k {
+            0 => "MAN",
+            300 => "AUTO",
+            _ => "",
+        };
+        out.push_str(&format!("{},{mode}\n", r.join(",")));
+    }
+    let p = dir.path().join("mode.csv");
+    std::fs::write(&p, out).unwrap();
+    let p = p.to_str().unwrap();
+    let v = json(&ok(&[
+        "diagnose", p, "--sp", "sp", "--mode", "mode", "--json",
+    ]));
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    assert_eq!(v["analysed"][0], 300, "{v:#}");
+    let human = ok(&[
+        "diagnose",
+        p,
+        "--sp",
+        "sp",
+        "--mode",
+        "mode",
+        "--no-quantify",
+    ]);
+    assert!(
+        human.contains("the mode in column 'mode' is stored only when it changes"),
+        "{human}"
+    );
+}
+
+#[test]
 fn bad_input_is_one_clear_sentence() {
     let dir = tempfile::tempdir().unwrap();
     let f = simulate(dir.path(), "loop.csv", "2", &[]);
