@@ -8,6 +8,8 @@ use std::collections::HashMap;
 
 /// Rows searched for a header below a preamble.
 pub const HEADER_SEARCH: usize = 20;
+/// A narrow export has at most this many columns.
+const NARROW_WIDTH: usize = 6;
 
 impl Table {
     /// `self` laid out so that the `wanted` columns are named: its header found below a
@@ -115,6 +117,10 @@ impl Table {
         }
         let n = self.len();
         let width = self.headers.len();
+        // narrow exports have a handful of columns (tag, time, value, status, units)
+        if width > NARROW_WIDTH {
+            return None;
+        }
         let tag = (0..width).find(|&c| {
             signals
                 .iter()
