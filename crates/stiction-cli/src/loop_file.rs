@@ -174,7 +174,7 @@ impl LoopFile {
                 .map(|(name, k)| format!("{name} {k}"))
                 .collect();
             format!(
-                "{} treated as missing ({}: blank, NaN, #N/A or a historian state such as Bad Input); they are gaps in the record",
+                "{} treated as missing ({}: blank, NaN, #N/A or a historian state such as Bad Input): gaps in the record (short ones bridged, longer ones split it)",
                 count(total, "cell", "cells"),
                 which.join(", ")
             )
