@@ -309,9 +309,16 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
         return Err(table.no_rows());
     }
     let mut missing = Vec::new();
+    let mut units = Vec::new();
     let mut column = |name: &str, flag: &str, role: &str| -> Result<Vec<f64>> {
         let c = table.require(name, flag, role)?;
         let v = table.numbers(c)?;
+        if let Some(u) = table.unit(c) {
+            units.push(format!(
+                "'{u}' after every number of column '{}'",
+                table.headers[c]
+            ));
+        }
         let k = v.iter().filter(|x| x.is_nan()).count();
         if k > 0 {
             missing.push((table.headers[c].clone(), k));
@@ -325,6 +332,9 @@ pub fn read_loop(table: &Table, s: &Signals, spec: &TimeSpec) -> Result<LoopFile
         s.mv.map(|c| column(c, "--mv", "valve position mv"))
             .transpose()?;
     let mut notes = table.notes.clone();
+    if !units.is_empty() {
+        notes.push(format!("{}: dropped, the numbers read", units.join("; ")));
+    }
     let auto = match s.mode {
         Some(c) => {
             let col = table.require(c, "--mode", "controller mode")?;

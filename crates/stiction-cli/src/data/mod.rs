@@ -185,7 +185,24 @@ pub fn read_pair(
             table.headers[a]
         );
     }
-    let notes: Vec<String> = table.notes.iter().cloned().chain(s.note).collect();
+    let units: Vec<String> = [a, b]
+        .iter()
+        .filter_map(|&c| {
+            table.unit(c).map(|u| {
+                format!(
+                    "'{u}' after every number of column '{}': dropped",
+                    table.headers[c]
+                )
+            })
+        })
+        .collect();
+    let notes: Vec<String> = table
+        .notes
+        .iter()
+        .cloned()
+        .chain(units)
+        .chain(s.note)
+        .collect();
     Ok(Pair {
         a: av,
         b: s.columns[1][s.start..s.end].to_vec(),

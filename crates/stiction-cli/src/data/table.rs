@@ -195,14 +195,28 @@ impl Table {
 
     /// Parse a column as numbers: NaN where a cell is missing (blank, NaN, #N/A, a historian
     /// state such as Bad Input); an error for any other text.
+    /// A unit written after every number of the column (`12.5 m3/h`, `45.2%`) is dropped
+    /// ([`Table::unit`]).
     pub fn numbers(&self, col: usize) -> Result<Vec<f64>> {
         let name = &self.headers[col];
         let file = self.path.display();
         let mut out = Vec::with_capacity(self.len());
+        let unit = self.unit(col);
+        let bare = |cell: &'_ str| -> String {
+            match &unit {
+                Some(u) => cell
+                    .strip_suffix(u.as_str())
+                    .unwrap_or(cell)
+                    .trim_end()
+                    .to_string(),
+                None => cell.to_string(),
+            }
+        };
         // digits grouped by thousands: the convention the column's unambiguous cells show
-        let grouping = Grouping::of((0..self.len()).map(|i| self.cell(i, col)));
-        for i in 0..self.len() {
-            let cell = self.cell(i, col);
+        let cells: Vec<String> = (0..self.len()).map(|i| bare(self.cell(i, col))).collect();
+        let grouping = Grouping::of(cells.iter().map(String::as_str));
+        for (i, cell) in cells.iter().enumerate() {
+            let cell = cell.as_str();
             if is_missing(cell) {
                 out.push(f64::NAN);
                 continue;
@@ -225,6 +239,45 @@ impl Table {
             out.push(v);
         }
         Ok(out)
+    }
+
+    /// The unit every present cell of a column writes after its number (`12.5 m3/h`, `45.2 %`,
+    /// `45.2%`): the same text of at most 12 characters, starting with neither a digit nor a
+    /// sign; `None` when a cell has none or another.
+    pub fn unit(&self, col: usize) -> Option<String> {
+        let mut unit: Option<&str> = None;
+        for i in 0..self.len() {
+            let cell = self.cell(i, col);
+            if is_missing(cell) {
+                continue;
+            }
+            // the number ends at the first character no number holds (an e or E only as an
+            // exponent, before a digit or a sign)
+            let bytes = cell.as_bytes();
+            let at = cell
+                .char_indices()
+                .find(|&(k, c)| {
+                    let exponent = (c == 'e' || c == 'E')
+                        && k > 0
+                        && bytes
+                            .get(k + 1)
+                            .is_some_and(|b| b.is_ascii_digit() || *b == b'-' || *b == b'+');
+                    !(c.is_ascii_digit() || ".,+- '".contains(c) || exponent)
+                })
+                .map(|(k, _)| k)?;
+            let (number, u) = cell.split_at(at);
+            let u = u.trim();
+            let ok = !number.trim().is_empty()
+                && u.len() <= 12
+                && !u.starts_with(|c: char| c.is_ascii_digit() || c == '-' || c == '+');
+            match unit {
+                _ if !ok => return None,
+                None => unit = Some(u),
+                Some(v) if v != u => return None,
+                Some(_) => {}
+            }
+        }
+        unit.map(str::to_string)
     }
 
     /// How many cells of a column are missing values.
@@ -395,6 +448,35 @@ fn shown(cell: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn column(cells: &[&str]) -> Table {
+        let mut t = Table::new(Path::new("t.csv"), vec!["pv".into()]);
+        for (i, c) in cells.iter().enumerate() {
+            t.push_row([*c], i as u64 + 2);
+        }
+        t
+    }
+
+    #[test]
+    fn a_unit_after_every_number_is_dropped() {
+        let t = column(&["12.5 m3/h", "Bad Input", "1,234.5 m3/h", "-3e2 m3/h"]);
+        assert_eq!(t.unit(0).as_deref(), Some("m3/h"));
+        let v = t.numbers(0).unwrap();
+        assert_eq!((v[0], v[2], v[3]), (12.5, 1234.5, -300.0));
+        assert!(v[1].is_nan());
+        assert_eq!(
+            column(&["45.2%", "50%"]).numbers(0).unwrap(),
+            vec![45.2, 50.0]
+        );
+        assert_eq!(
+            column(&["12.5 EUR", "13 EUR"]).unit(0).as_deref(),
+            Some("EUR")
+        );
+        // no unit, or units that differ: none dropped
+        assert_eq!(column(&["12.5", "1e-3"]).unit(0), None);
+        assert_eq!(column(&["12.5 m3/h", "13 kg/h"]).unit(0), None);
+        assert!(column(&["12.5 m3/h", "13"]).numbers(0).is_err());
+    }
 
     #[test]
     fn times_of_day_and_midnight() {

@@ -500,6 +500,25 @@ fn time_columns_by_their_common_names_and_a_note_without_one() {
 }
 
 #[test]
+fn units_after_every_number_are_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    let (csv, rows) = sticky(dir.path());
+    let reference = band(&[s(&csv)]);
+    let mut out = String::from("t,op,pv\n");
+    for r in &rows {
+        out.push_str(&format!("{},{} %,{} m3/h\n", r[0], r[2], r[4]));
+    }
+    let p = dir.path().join("units.csv");
+    std::fs::write(&p, out).unwrap();
+    assert_eq!(band(&[s(&p)]), reference);
+    let text = ok(&["diagnose", s(&p), "--no-quantify"]);
+    assert!(
+        text.contains("'%' after every number of column 'op'; 'm3/h' after every number of column 'pv': dropped"),
+        "{text}"
+    );
+}
+
+#[test]
 fn crlf_files_name_the_right_line() {
     // Windows programs end lines with CRLF; the csv reader's own count ran one line short there
     let dir = tempfile::tempdir().unwrap();
