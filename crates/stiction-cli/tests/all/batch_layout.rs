@@ -210,6 +210,63 @@ pv = "GHOST.PV"
 }
 
 #[test]
+fn a_loop_list_names_the_tags_of_a_narrow_export() {
+    // a row per tag and time (tag, time, value): the list's columns are tags
+    let dir = tempfile::tempdir().unwrap();
+    let sticky = dir.path().join("sticky.csv");
+    closed_stenman(&sticky, "2", &["--noise", "0.05", "--seed", "1"]);
+    let mut text = String::from("tag,time,value\n");
+    for line in std::fs::read_to_string(&sticky).unwrap().lines().skip(1) {
+        let c: Vec<&str> = line.split(',').collect(); // t,sp,op,mv,pv
+        for (tag, k) in [
+            ("FIC101.OP", 2),
+            ("FIC101.PV", 4),
+            ("LIC7.OP", 2),
+            ("LIC7.PV", 4),
+        ] {
+            text.push_str(&format!("{tag},{},{}\n", c[0], c[k]));
+        }
+    }
+    let file = dir.path().join("plant.csv");
+    std::fs::write(&file, text).unwrap();
+    let list = dir.path().join("loops.toml");
+    let entry = |id: &str, tag: &str| {
+        format!(
+            "[[loop]]\nid = \"{id}\"\nfile = \"plant.csv\"\nop = \"{tag}.OP\"\npv = \"{tag}.PV\"\n"
+        )
+    };
+    let toml = [
+        entry("FIC101", "FIC101"),
+        entry("LIC7", "LIC7"),
+        entry("BAD", "NOPE"),
+    ]
+    .concat();
+    std::fs::write(&list, toml).unwrap();
+    let out = dir.path().join("out");
+    let (text, _) = batch(
+        &[
+            "batch",
+            s(&file),
+            "-o",
+            s(&out),
+            "--columns",
+            s(&list),
+            "--no-quantify",
+        ],
+        3,
+    );
+    assert!(text.contains("3 loops"), "{text}");
+    let rows = summary(&out);
+    assert_eq!(rows["FIC101"]["verdict"], "stiction");
+    assert_eq!(rows["LIC7"]["verdict"], "stiction");
+    let bad = &rows["BAD"]["error"];
+    assert!(
+        bad.contains("no column 'NOPE.OP'") && bad.contains("the file looks narrow"),
+        "{bad}"
+    );
+}
+
+#[test]
 fn a_csv_loop_list_gives_options_to_the_loops_of_a_long_format_file() {
     let dir = tempfile::tempdir().unwrap();
     let a = dir.path().join("a.csv");
