@@ -46,9 +46,11 @@ pub fn run(a: Args) -> Result<()> {
     let req = req.check().map_err(core_error)?;
     let d = diagnose_checked(&lf.record(), &req).map_err(core_error)?;
     let names = a.columns.names();
+    let reading = lf.reading_notes();
     let options = PageOptions {
         columns: Some(&names),
         back_link: None,
+        reading: &reading,
     };
     let html = stiction_report::loop_page(&id, &lf.data(), &d, &options)
         .with_context(|| format!("{}: cannot render the report", a.output.display()))?;

@@ -158,6 +158,14 @@ impl LoopFile {
         self.rows.as_ref().map_or(k, |r| r[k])
     }
 
+    /// What reading decided, in words: the missing-cells note and the reader's notes.
+    pub fn reading_notes(&self) -> Vec<String> {
+        self.missing_note()
+            .into_iter()
+            .chain(self.notes.iter().cloned())
+            .collect()
+    }
+
     /// All cells treated as missing.
     pub fn missing_total(&self) -> usize {
         self.missing.iter().map(|(_, k)| k).sum()

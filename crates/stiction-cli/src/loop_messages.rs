@@ -23,7 +23,7 @@ pub fn core_error(name: &str, _lf: &LoopFile, e: DiagnoseError) -> anyhow::Error
 /// What the reader decided (gaps, time order, time form): lines of the human output, or notes
 /// on standard error beside JSON.
 pub fn print_notes(name: &str, lf: &LoopFile, stderr: bool) {
-    for n in lf.missing_note().iter().chain(&lf.notes) {
+    for n in &lf.reading_notes() {
         if stderr {
             eprintln!("note: {name}: {n}");
         } else {

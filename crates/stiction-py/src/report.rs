@@ -48,6 +48,7 @@ fn page(
     let options = PageOptions {
         columns: names,
         back_link: None,
+        reading: &p.notes,
     };
     stiction_report::loop_page(loop_id, &data, &d, &options).map_err(|e| {
         PyRuntimeError::new_err(format!(

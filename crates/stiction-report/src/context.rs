@@ -154,7 +154,7 @@ pub fn build(loop_id: &str, data: &LoopData, d: &Diagnosis, o: &PageOptions) -> 
         convergence: q.map(sections::convergence),
         quality: sections::quality(d),
         windows: sections::windows(d),
-        notes: sections::notes(d, q),
+        notes: sections::notes(d, q, o.reading),
         seconds: num(d.seconds),
     })
 }

@@ -69,6 +69,9 @@ pub struct PageOptions<'a> {
     pub columns: Option<&'a ColumnNames>,
     /// A link above the title: (href, text), e.g. batch's `("../index.html", "all loops")`.
     pub back_link: Option<(String, String)>,
+    /// What reading the record decided (gaps, a grid, a pivot, the time's form), shown in the
+    /// page's notes.
+    pub reading: &'a [String],
 }
 
 /// Escape text for HTML element content and quoted attribute values.

@@ -468,11 +468,13 @@ pub fn windows(d: &Diagnosis) -> Option<Windows> {
 
 #[derive(Serialize)]
 pub struct Notes {
+    /// What reading the record decided.
+    pub reading: Vec<String>,
     pub warnings: Vec<String>,
     pub caveat: String,
 }
 
-pub fn notes(d: &Diagnosis, q: Option<&Quantification>) -> Notes {
+pub fn notes(d: &Diagnosis, q: Option<&Quantification>, reading: &[String]) -> Notes {
     let warnings = d
         .warnings
         .iter()
@@ -488,6 +490,7 @@ pub fn notes(d: &Diagnosis, q: Option<&Quantification>) -> Notes {
         }
     };
     Notes {
+        reading: reading.to_vec(),
         warnings,
         caveat: format!("{}.", caveat.trim_end_matches('.')),
     }

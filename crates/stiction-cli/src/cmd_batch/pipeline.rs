@@ -219,9 +219,11 @@ fn read_loop(loaded: Loaded, columns: &Columns) -> Result<LoopFile, String> {
 /// The loop's full report (`stiction report`), with a link back to the fleet's index page.
 fn render_report(loop_id: &str, lf: &LoopFile, d: &Diagnosis, columns: &Columns) -> Result<String> {
     let names = columns.names();
+    let reading = lf.reading_notes();
     let options = PageOptions {
         columns: Some(&names),
         back_link: Some(("../index.html".into(), "all loops".into())),
+        reading: &reading,
     };
     stiction_report::loop_page(loop_id, &lf.data(), d, &options)
 }

@@ -157,6 +157,33 @@ fn report_escapes_file_and_column_names_and_shows_windows() {
 }
 
 #[test]
+fn report_says_how_the_record_was_read() {
+    // a unit after every number: dropped by the reader, and the page says so beside the
+    // diagnosis' own notes
+    let dir = tempfile::tempdir().unwrap();
+    let csv = sticky_loop(dir.path());
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let mut out = format!("{}\n", lines.next().unwrap());
+    for l in lines {
+        out.push_str(&format!("{l} m3/h\n"));
+    }
+    let p = dir.path().join("units.csv");
+    std::fs::write(&p, out).unwrap();
+    let html = dir.path().join("r.html");
+    ok(&["report", s(&p), "--no-quantify", "-o", s(&html)]);
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(
+        page.contains("How the record was read:"),
+        "no reading notes"
+    );
+    assert!(
+        page.contains("&#39;m3/h&#39; after every number of column &#39;pv&#39;"),
+        "the unit note is missing"
+    );
+}
+
+#[test]
 fn missing_column_is_one_line_naming_it() {
     let dir = tempfile::tempdir().unwrap();
     let csv = sticky_loop(dir.path());
