@@ -71,3 +71,15 @@ def test_report_bad_input_is_one_sentence(sticky_csv, tmp_path):
     with pytest.raises(ValueError, match=r"ts=-1"):
         stiction.report(op=np.ones(500), pv=np.ones(500), ts=-1, path=tmp_path / "x.html")
     assert not (tmp_path / "x.html").exists()
+
+
+def test_report_says_how_the_record_was_read(sticky_csv, tmp_path):
+    # op stored at even seconds, pv at odd ones: put on a grid, and the page says so
+    df = pd.read_csv(sticky_csv)
+    df.loc[df.index % 2 == 1, "op"] = np.nan
+    df.loc[(df.index % 2 == 0) & (df.index > 0), "pv"] = np.nan
+    path = tmp_path / "merged.html"
+    stiction.report(df, sp="sp", path=path, quantify=False)
+    html = path.read_text(encoding="utf-8")
+    assert "How the record was read:" in html
+    assert "stored at their own times" in html
