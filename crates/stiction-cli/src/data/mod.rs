@@ -13,6 +13,7 @@ mod sheet;
 mod table;
 mod text;
 pub mod time;
+mod time_column;
 
 #[cfg(test)]
 mod proptests;

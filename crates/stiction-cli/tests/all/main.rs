@@ -9,6 +9,7 @@ mod batch_faults;
 mod batch_layout;
 mod cli;
 mod diagnose;
+mod exports;
 mod first_hour;
 mod json_pin;
 mod limit_cycle;

@@ -11,30 +11,19 @@
 use crate::diagnose::LoopRecord;
 use std::borrow::Cow;
 
+mod cells;
 mod gaps;
 mod numbers;
 mod own_times;
+mod time;
+pub use cells::{is_missing, mode_word, MISSING_MARKERS};
 pub use gaps::{
     bridged, bridged_note, longest_clean, short_gaps, BRIDGE_MAX_RUN, BRIDGE_MAX_SHARE,
 };
 pub use numbers::{parse_number, parse_number_grouped, Grouping};
 pub use own_times::OWN_TIMES_SHARE;
-
-/// Column names taken as the time, in this order (any case), when none is named: the common
-/// names of historian and spreadsheet exports.
-pub const TIME_NAMES: &[&str] = &[
-    "t",
-    "time",
-    "timestamp",
-    "time stamp",
-    "datetime",
-    "date time",
-    "date/time",
-    "date",
-    "zeit",
-    "zeitstempel",
-    "datum",
-];
+use time::count;
+pub use time::{fill_times, sampling_time, time_order, TIME_NAMES};
 
 /// The signals of one loop, as columns (gaps NaN; `auto` `true` where the controller is in
 /// automatic; `time` in seconds).
@@ -249,138 +238,6 @@ fn reorder(s: &mut Signals, keep: &[usize]) {
     }
     if let Some(a) = s.auto.as_mut() {
         *a = Cow::Owned(pick(a, keep));
-    }
-}
-
-/// The median step of a time column, if time increases (NaN entries are skipped), rounded to
-/// the microsecond: timestamps since 1970 carry about 1e-7 s of float noise.
-pub fn sampling_time(t: &[f64]) -> Option<f64> {
-    let finite: Vec<f64> = t.iter().copied().filter(|v| v.is_finite()).collect();
-    let mut steps: Vec<f64> = finite.windows(2).map(|w| w[1] - w[0]).collect();
-    if steps.is_empty() {
-        return None;
-    }
-    steps.sort_by(f64::total_cmp);
-    let ts = steps[steps.len() / 2];
-    let rounded = (ts * 1e6).round() / 1e6;
-    let ts = if rounded > 0.0 { rounded } else { ts };
-    (ts > 0.0 && ts.is_finite()).then_some(ts)
-}
-
-/// Fill NaN times by straight lines between their neighbours (by the median step past the
-/// ends). False when no time is known.
-pub fn fill_times(t: &mut [f64]) -> bool {
-    let known: Vec<usize> = (0..t.len()).filter(|&k| t[k].is_finite()).collect();
-    let (Some(&first), Some(&last)) = (known.first(), known.last()) else {
-        return false;
-    };
-    // the median step per sample between known times (neighbours or not)
-    let mut steps: Vec<f64> = known
-        .windows(2)
-        .map(|w| (t[w[1]] - t[w[0]]) / (w[1] - w[0]) as f64)
-        .collect();
-    steps.sort_by(f64::total_cmp);
-    let step = steps.get(steps.len() / 2).copied().unwrap_or(1.0);
-    for k in 0..first {
-        t[k] = t[first] - (first - k) as f64 * step;
-    }
-    for k in last + 1..t.len() {
-        t[k] = t[last] + (k - last) as f64 * step;
-    }
-    for w in known.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        for k in a + 1..b {
-            t[k] = t[a] + (t[b] - t[a]) * (k - a) as f64 / (b - a) as f64;
-        }
-    }
-    true
-}
-
-fn count(n: usize, one: &str, many: &str) -> String {
-    format!("{n} {}", if n == 1 { one } else { many })
-}
-
-/// The rows to keep, in time order, when the time is not in order or repeats (the first row of
-/// each time kept), with a note; `None` when time only increases.
-pub fn time_order(t: &[f64]) -> Option<(Vec<usize>, String)> {
-    if t.windows(2).all(|w| w[1] > w[0]) {
-        return None;
-    }
-    let backwards = t.windows(2).filter(|w| w[1] < w[0]).count();
-    let mut keep: Vec<usize> = (0..t.len()).collect();
-    keep.sort_by(|&a, &b| t[a].total_cmp(&t[b]).then(a.cmp(&b)));
-    let before = keep.len();
-    keep.dedup_by(|b, a| t[*a] == t[*b]);
-    let repeats = before - keep.len();
-    let mut said = Vec::new();
-    if backwards > 0 {
-        said.push(format!(
-            "the rows are not in time order ({} back): sorted by time",
-            count(backwards, "step goes", "steps go")
-        ));
-    }
-    if repeats > 0 {
-        said.push(format!(
-            "{} an earlier row's time: the first row of each time is kept",
-            count(repeats, "row repeats", "rows repeat")
-        ));
-    }
-    Some((keep, said.join("; ")))
-}
-
-// The cells of plant exports: missing values as historians write them, numbers with a
-// decimal comma. Blank cells, `NaN`, `#N/A` and historian states are gaps, not errors.
-
-/// Cell texts read as a missing value (compared case-insensitively, after trimming). The last
-/// ones are OSIsoft PI's system digital states for a failed or absent reading, and Excel's cell
-/// errors.
-pub const MISSING_MARKERS: &[&str] = &[
-    "",
-    "nan",
-    "-nan",
-    "#n/a",
-    "null",
-    "none",
-    "bad",
-    "bad input",
-    "bad data",
-    "bad quality",
-    "i/o timeout",
-    "shutdown",
-    "comm fail",
-    "no data",
-    "no sample",
-    "calc failed",
-    "scan off",
-    "scan timeout",
-    "pt created",
-    "configure",
-    "not connected",
-    "intf shut",
-    "out of serv",
-    "invalid data",
-    "#value!",
-    "#div/0!",
-    "#ref!",
-    "#num!",
-    "#null!",
-    "#name?",
-];
-
-/// Whether a cell's text stands for a missing value.
-pub fn is_missing(cell: &str) -> bool {
-    let c = cell.trim();
-    c.len() <= 13 && MISSING_MARKERS.iter().any(|m| m.eq_ignore_ascii_case(c))
-}
-
-/// A controller mode cell in words: `Some(true)` for automatic (auto, automatic, aut, a, 1, true,
-/// on, cascade, cas), `Some(false)` for manual (manual, man, m, 0, false, off), any case;
-/// `None` for anything else (a missing cell is the front end's to judge).
-pub fn mode_word(cell: &str) -> Option<bool> {
-    match cell.trim().to_ascii_lowercase().as_str() {
-        "auto" | "automatic" | "aut" | "a" | "1" | "true" | "on" | "cascade" | "cas" => Some(true),
-        "manual" | "man" | "m" | "0" | "false" | "off" => Some(false),
-        _ => None,
     }
 }
 
