@@ -66,10 +66,7 @@ impl Table {
             Some(a) => names(a).iter().map(|c| c.to_string()).collect(),
             None => self.headers.clone(),
         };
-        let mut t = Table::new(&self.path, headers);
-        t.row_word = self.row_word;
-        t.sheet = self.sheet.clone();
-        t.sheets = self.sheets.clone();
+        let mut t = self.with_headers(headers);
         for i in first..self.len() {
             t.push_row(names(i), self.lines[i]);
         }
@@ -99,7 +96,6 @@ impl Table {
                 text.join("; ")
             ));
         }
-        t.notes = self.notes.clone();
         t.notes.push(self.row_word.words(said.join("; ")));
         Some(t)
     }
@@ -172,14 +168,10 @@ impl Table {
         let headers: Vec<String> = std::iter::once(self.headers[time_col].clone())
             .chain(tags.iter().cloned())
             .collect();
-        let mut t = Table::new(&self.path, headers);
-        t.row_word = self.row_word;
-        t.sheet = self.sheet.clone();
-        t.sheets = self.sheets.clone();
+        let mut t = self.with_headers(headers);
         for (row, line) in rows.iter().zip(&lines) {
             t.push_row(row.iter().copied(), *line);
         }
-        t.notes = self.notes.clone();
         let mut note = format!(
             "the file is narrow (a row per tag and time: columns {}, {} and {}): {} values of {} turned into a column per tag at {} distinct times",
             self.headers[tag],

@@ -73,6 +73,17 @@ impl Table {
         }
     }
 
+    /// An empty table from the same file with other headers: its row words, sheets and notes
+    /// kept (for a table laid out anew, [`Table::for_columns`]).
+    pub(super) fn with_headers(&self, headers: Vec<String>) -> Table {
+        let mut t = Table::new(&self.path, headers);
+        t.row_word = self.row_word;
+        t.sheet = self.sheet.clone();
+        t.sheets = self.sheets.clone();
+        t.notes = self.notes.clone();
+        t
+    }
+
     /// Messages call rows "row N" (sheets, Parquet) instead of "line N".
     pub(super) fn rows_are_rows(mut self) -> Table {
         self.row_word = RowWord::Row;

@@ -103,7 +103,11 @@ pub(super) fn on_grid(s: &Signals, ts: f64) -> Option<(Signals<'static>, Vec<usi
         rows.push(r);
     }
     let line = |v: &[f64]| interpolated(t, v, &grid);
-    let held_sp = |v: &[f64]| rows.iter().map(|&r| held_at(v, r)).collect::<Vec<f64>>();
+    // the setpoint held: each row's last stored value, once, then picked at each grid time
+    let held_sp = |v: &[f64]| {
+        let by_row = held(v);
+        rows.iter().map(|&r| by_row[r]).collect::<Vec<f64>>()
+    };
     let signals = Signals {
         op: Cow::Owned(line(&s.op)),
         pv: Cow::Owned(line(&s.pv)),
@@ -116,16 +120,6 @@ pub(super) fn on_grid(s: &Signals, ts: f64) -> Option<(Signals<'static>, Vec<usi
         time: Some(Cow::Owned(grid)),
     };
     Some((signals, rows))
-}
-
-/// `v`'s last stored value at or before row `r` (NaN before its first).
-fn held_at(v: &[f64], r: usize) -> f64 {
-    v[..=r]
-        .iter()
-        .rev()
-        .copied()
-        .find(|x| x.is_finite())
-        .unwrap_or(f64::NAN)
 }
 
 /// `v` (stored where finite, at times `t`) by straight lines at the times `grid`; not across
@@ -213,8 +207,8 @@ mod tests {
         assert!(out[45].is_nan() && out[39] == 39.0 && out[60] == 60.0);
         v[45..60].copy_from_slice(&t[45..60]);
         assert_eq!(interpolated(&t, &v, &t)[42], 42.0);
-        assert_eq!(held_at(&[1.0, f64::NAN, 3.0, f64::NAN], 3), 3.0);
-        assert!(held_at(&[f64::NAN, 2.0], 0).is_nan());
+        assert_eq!(held(&[1.0, f64::NAN, 3.0, f64::NAN])[3], 3.0);
+        assert!(held(&[f64::NAN, 2.0])[0].is_nan());
         let h = held(&[f64::NAN, 1.0, f64::NAN, f64::NAN, 3.0, f64::NAN]);
         assert!(h[0].is_nan());
         assert_eq!(&h[1..], &[1.0, 1.0, 1.0, 3.0, 3.0]);
