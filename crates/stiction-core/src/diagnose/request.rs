@@ -32,6 +32,11 @@ pub struct DiagnoseRequest {
     /// Default `[0, 100]` (OP in % of span).
     #[serde(default = "default_op_range")]
     pub op_range: [f64; 2],
+    /// The model family also runs the levels test ([`crate::identify::levels`]): every distinct
+    /// Stenman valve scored on PV's levels. Finds more sticky valves on records sampled at every
+    /// controller execution, at about a second a loop of 2,000 samples.
+    #[serde(default)]
+    pub thorough: bool,
 }
 
 fn default_op_range() -> [f64; 2] {
@@ -52,6 +57,7 @@ impl Default for DiagnoseRequest {
             estimate_start: false,
             verdict_margin: 0.3,
             op_range: default_op_range(),
+            thorough: false,
         }
     }
 }

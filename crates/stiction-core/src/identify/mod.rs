@@ -15,6 +15,7 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod levels;
 mod output_error;
 mod physical;
 mod prepared;

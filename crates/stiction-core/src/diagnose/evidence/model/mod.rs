@@ -22,10 +22,15 @@
 //! to 42, and at the same healthy percentile the test finds 37 % of the sticky routine loops
 //! instead of 32 %, and 61 % of the sticky fast loops instead of 48 %.)
 
+mod levels;
+
+pub use levels::{LevelsEvidence, LEVELS_STICTION, MAX_UNRECORDED};
+
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
 use crate::diagnose::result::Vote;
 use crate::identify::Structure;
 use crate::quantify::FitComparison;
+use levels::LevelsTest;
 use serde::{Deserialize, Serialize};
 
 /// The model family.
@@ -127,6 +132,9 @@ pub struct ModelEvidence {
     pub sse_noise: f64,
     /// How the test ratio was calibrated ([`CALIBRATION`]).
     pub calibration: String,
+    /// The levels test, when the request is `thorough` and it ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub levels: Option<LevelsEvidence>,
 }
 
 /// The statistics of a comparison: shares of the compared output's variance above its noise.
@@ -183,7 +191,9 @@ impl EvidenceFamily for Model {
         let levels = Levels::of(f);
         let improvement = levels.improvement;
         let d = f.stenman.params[0];
-        let evidence = model_evidence(ctx, f, &levels);
+        let test = LevelsTest::of(ctx);
+        let mut evidence = model_evidence(ctx, f, &levels);
+        evidence.levels = test.evidence().cloned();
         let fits = format!(
             "R² {:.3} without stiction, {:.3} with (Stenman d = {:.2} % of span; Kano S = {:.2}, J = {:.2})",
             f.linear.r2,
@@ -192,7 +202,13 @@ impl EvidenceFamily for Model {
             evidence.kano_s,
             evidence.kano_j
         );
-        let (vote, strength, why) = vote(ctx, f, &levels);
+        let (mut vote, mut strength, mut why) = vote(ctx, f, &levels);
+        if vote != Vote::Stiction && levels.explained >= MIN_EXPLAINED {
+            if let Some(s) = test.stiction_strength() {
+                why = format!("the levels test finds a sticky valve where the fit of PV's changes does not ({why})");
+                (vote, strength) = (Vote::Stiction, s);
+            }
+        }
         // measured, between the thresholds: the fit gains more than most healthy loops give
         let leans = (vote == Vote::Undetermined
             && levels.significance > SIGNIFICANCE_NONE
@@ -205,7 +221,10 @@ impl EvidenceFamily for Model {
             value: Some(improvement),
             statistic: statistic.into(),
             threshold,
-            note: format!("{why}; {fits}"),
+            note: match test.words() {
+                Some(w) => format!("{why}; {fits}; {w}"),
+                None => format!("{why}; {fits}"),
+            },
             leans,
             model: Some(evidence),
             stick_slip: None,
@@ -249,6 +268,7 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
         sse_stiction: f.stenman.sse.min(f.slip_jump.sse),
         sse_noise: f.samples_used as f64 * f.noise_var,
         calibration: CALIBRATION.into(),
+        levels: None,
     }
 }
 
