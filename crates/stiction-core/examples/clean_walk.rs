@@ -7,7 +7,12 @@
 //! it: the same test with the recorded valve position (a ceiling), the model family's vote and
 //! `diagnose`'s verdict, and what the verdict would be with the walk's test added.
 //!
-//!     cargo run --release -p stiction-core --example clean_walk -- [--suite routine|fast] [--benchmark] [--out FILE]
+//!     cargo run --release -p stiction-core --example clean_walk -- [--suite routine|fast] [--benchmark] [--out FILE] [--jsonl FILE]
+//!
+//! `--jsonl FILE` also writes a line per loop with the walked ratio, the same walk whitened by an
+//! AR noise model (`identify::levels`, the levels test `diagnose --thorough` runs), the whitened
+//! walk held to 40 bands of a geometric grid only (`coarse`: a cheap walk loses most of what the
+//! exact one finds), the recorded valve's ratios and `diagnose`'s result.
 //!
 //! Slow on purpose (every trajectory fitted in full, about 0.15 s for 750 samples and 2 s for
 //! 2,000 on one core): a study, not a method `diagnose` can afford as it stands.
@@ -24,6 +29,7 @@ use rayon::prelude::*;
 use std::fmt::Write as _;
 use stiction_core::diagnose::{diagnose, Family, Verdict, Vote};
 use stiction_core::estimate::exact::stenman_walk;
+use stiction_core::identify::levels::LevelsFit;
 use stiction_core::models::Model;
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, Set, Suite, Truth};
 use study_args::StudyArgs;
@@ -36,8 +42,16 @@ const BANK: Bank = Bank {
 /// The ratios reported; [`ADDED`] is the one the "added" verdicts use.
 const SHOWS: [f64; 2] = [20.0, 30.0];
 const ADDED: f64 = 30.0;
+/// Bands on the coarse geometric grid (0.2 % to half of OP's range).
+const COARSE: usize = 40;
 
 struct Row {
+    id: String,
+    walked_white: f64,
+    recorded_white: f64,
+    coarse: f64,
+    coarse_cells: usize,
+    diagnosis: Option<String>,
     class: String,
     truth: Truth,
     samples: usize,
@@ -57,12 +71,22 @@ fn judge(l: &BenchmarkLoop) -> Row {
     let clock = std::time::Instant::now();
     let fit = CleanFit::new(&d.pv, l.integrating, BANK);
     let with_op = fit.sse(&d.op);
+    // the same test whitened by an AR noise model (`identify::levels`, what `--thorough` runs)
+    let white = LevelsFit::new(&d.pv, &d.op, l.integrating);
+    let mut scratch = white.scratch();
+    let white_op = white.sse(&d.op, &mut scratch);
+    let mut white_best = f64::INFINITY;
+    let mut coarse_best = f64::INFINITY;
+    let mut coarse_cells = 0usize;
     let (lo, hi) =
         d.op.iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
                 (a.min(x), b.max(x))
             });
     let range = (hi - lo).max(f64::MIN_POSITIVE);
+    let grid: Vec<f64> = (0..COARSE)
+        .map(|i| range * 0.002 * (250.0f64).powf(i as f64 / (COARSE - 1) as f64))
+        .collect();
     let (mut best, mut band, mut cells) = (f64::INFINITY, 0.0, 0);
     let mut valve = vec![0.0; d.op.len()];
     let whole = (0.0, range * (1.0 + 1e-9));
@@ -78,14 +102,31 @@ fn judge(l: &BenchmarkLoop) -> Row {
             if s < best {
                 (best, band) = (s, 0.5 * (cell.0 + cell.1));
             }
+            let w = white.sse(mv, &mut scratch);
+            white_best = white_best.min(w);
+            if grid.iter().any(|&g| g >= cell.0 && g < cell.1) {
+                coarse_best = coarse_best.min(w);
+                coarse_cells += 1;
+            }
         },
     );
     let n = d.pv.len() as f64;
     let walked = n / 2.0 * (with_op / best.max(f64::MIN_POSITIVE)).ln();
+    let walked_white = white.ratio(white_op, white_best);
+    let recorded_white = white.ratio(white_op, white.sse(&d.mv, &mut scratch));
+    let coarse = white.ratio(white_op, coarse_best);
     let seconds = clock.elapsed().as_secs_f64();
     let recorded = fit.llr(with_op, &d.mv);
     let diagnosis = diagnose(&catalogue_loop::record(l), &catalogue_loop::request(l)).ok();
     Row {
+        id: l.id.clone(),
+        walked_white,
+        recorded_white,
+        coarse,
+        coarse_cells,
+        diagnosis: diagnosis
+            .as_ref()
+            .and_then(|g| serde_json::to_string(g).ok()),
         class: l.class.to_string(),
         truth: l.truth,
         samples: d.pv.len(),
@@ -249,5 +290,12 @@ fn main() {
     };
     let loops = catalogue::catalogue(suite, set);
     let rows: Vec<Row> = loops.par_iter().map(judge).collect();
+    if let Some(path) = args.value("--jsonl") {
+        let mut out = String::new();
+        for r in &rows {
+            let _ = writeln!(out, "{{\"id\":\"{}\",\"class\":\"{}\",\"truth\":\"{}\",\"samples\":{},\"walked\":{},\"walked_white\":{},\"coarse\":{},\"coarse_cells\":{},\"recorded\":{},\"recorded_white\":{},\"band\":{},\"true_d\":{},\"diagnosis\":{}}}", r.id, r.class, r.truth.name(), r.samples, r.walked, r.walked_white, r.coarse, r.coarse_cells, r.recorded, r.recorded_white, r.band, r.true_d.map_or("null".into(), |d| d.to_string()), r.diagnosis.as_deref().unwrap_or("null"));
+        }
+        std::fs::write(path, out).unwrap_or_else(|e| args.fail(&format!("{path}: {e}")));
+    }
     args.emit(&table(&rows, set, suite));
 }
