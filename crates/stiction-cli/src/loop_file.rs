@@ -103,6 +103,11 @@ pub struct Columns {
     /// --estimate-start; about 3-4x the estimate's time)
     #[arg(long)]
     pub estimate_start: bool,
+    /// Model family: also score every distinct Stenman valve on PV's levels (the levels test;
+    /// finds more sticky valves in records sampled at every controller execution, about a second
+    /// a loop of 2,000 samples)
+    #[arg(long)]
+    pub thorough: bool,
     #[command(flatten)]
     pub reading: Reading,
 }
@@ -265,6 +270,7 @@ impl Columns {
             ts,
             integrating: self.integrating,
             estimate_start: self.estimate_start,
+            thorough: self.thorough,
             op_range: self.op_range.unwrap_or([0.0, 100.0]),
             ..DiagnoseRequest::default()
         }

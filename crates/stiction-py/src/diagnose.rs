@@ -16,6 +16,8 @@ pub struct Settings {
     pub quantify: bool,
     pub op_range: [f64; 2],
     pub estimate_start: bool,
+    /// The model family's levels test (the CLI's `--thorough`).
+    pub thorough: bool,
     /// The time column's name, for the sentence when time does not increase.
     pub time_name: String,
 }
@@ -27,6 +29,7 @@ impl Settings {
             ts,
             integrating: self.integrating,
             estimate_start: self.estimate_start,
+            thorough: self.thorough,
             op_range: self.op_range,
             window: self.window,
             quantify: self.quantify,
@@ -79,7 +82,7 @@ pub fn run<'a>(signals: Signals<'a>, s: &Settings) -> Result<(Diagnosis, Prepare
 /// the record's preparation (rows sorted, repeated times dropped).
 #[pyfunction]
 #[pyo3(signature = (op, pv, sp=None, mv=None, auto=None, time=None, ts=None, integrating=false,
-    window=None, quantify=true, op_range=(0.0, 100.0), estimate_start=false, time_name=None))]
+    window=None, quantify=true, op_range=(0.0, 100.0), estimate_start=false, thorough=false, time_name=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose(
     py: Python<'_>,
@@ -95,6 +98,7 @@ pub fn diagnose(
     quantify: bool,
     op_range: (f64, f64),
     estimate_start: bool,
+    thorough: bool,
     time_name: Option<String>,
 ) -> PyResult<(String, Vec<String>)> {
     let settings = Settings {
@@ -104,6 +108,7 @@ pub fn diagnose(
         quantify,
         op_range: [op_range.0, op_range.1],
         estimate_start,
+        thorough,
         time_name: time_name.unwrap_or_else(|| "time".into()),
     };
     let signals = Signals {

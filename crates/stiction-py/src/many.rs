@@ -93,7 +93,7 @@ fn row(fleet: &Fleet, id: &str, source: &str, (a, b): (usize, usize), s: &Settin
 /// end could not read, with the reason (a `failed` row each).
 #[pyfunction]
 #[pyo3(signature = (ids, sources, starts, op, pv, sp=None, mv=None, auto=None, time=None,
-    ts=None, integrating=false, quantify=true, op_range=(0.0, 100.0), estimate_start=false,
+    ts=None, integrating=false, quantify=true, op_range=(0.0, 100.0), estimate_start=false, thorough=false,
     time_name=None, threads=None, progress=false, failed=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose_many(
@@ -112,6 +112,7 @@ pub fn diagnose_many(
     quantify: bool,
     op_range: (f64, f64),
     estimate_start: bool,
+    thorough: bool,
     time_name: Option<String>,
     threads: Option<usize>,
     progress: bool,
@@ -143,6 +144,7 @@ pub fn diagnose_many(
         quantify,
         op_range: [op_range.0, op_range.1],
         estimate_start,
+        thorough,
         time_name: time_name.unwrap_or_else(|| "time".into()),
     };
     if [fleet.pv.len()]

@@ -62,7 +62,7 @@ fn page(
 /// header, when the signals came from named columns.
 #[pyfunction]
 #[pyo3(signature = (op, pv, sp=None, mv=None, auto=None, time=None, ts=None, integrating=false,
-    window=None, quantify=true, op_range=(0.0, 100.0), estimate_start=false, time_name=None,
+    window=None, quantify=true, op_range=(0.0, 100.0), estimate_start=false, thorough=false, time_name=None,
     loop_id="loop".to_string(), columns=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn report(
@@ -79,6 +79,7 @@ pub fn report(
     quantify: bool,
     op_range: (f64, f64),
     estimate_start: bool,
+    thorough: bool,
     time_name: Option<String>,
     loop_id: String,
     columns: Option<HashMap<String, String>>,
@@ -90,6 +91,7 @@ pub fn report(
         quantify,
         op_range: [op_range.0, op_range.1],
         estimate_start,
+        thorough,
         time_name: time_name.unwrap_or_else(|| "time".into()),
     };
     let names = columns

@@ -62,3 +62,21 @@ def test_estimate_and_simulate_equal_cli(cli, tmp_path):
         want = run_json(cli, "estimate", path, "--method", method, "--seed", "3")
         got = stiction.estimate(theirs["op"], theirs["mv"], method=method, seed=3)
         assert without_seconds(got.to_dict()) == without_seconds(want), method
+
+
+def test_thorough_equals_cli(cli, tmp_path):
+    """thorough=True runs the model family's levels test, as --thorough does."""
+    f = tmp_path / "steps.csv"
+    subprocess.run(
+        [cli, "simulate", "--loop", "closed", "--param", "d=2", "--samples", "1500", "--noise", "0.05",
+         "--seed", "3", "--sp", "steps:amplitude=4,hold=200,offset=50,seed=2", "--pi", "Kc=0.3,Ti=20",
+         "-o", str(f)],
+        check=True, capture_output=True,
+    )
+    want = run_json(cli, "diagnose", f, "--sp", "sp", "--thorough", "--no-quantify")
+    got = stiction.diagnose(pd.read_csv(f), sp="sp", quantify=False, thorough=True)
+    assert without_seconds(got.to_dict()) == without_seconds(want)
+    model = next(x for x in want["families"] if x["family"] == "model")
+    assert model["model"]["levels"]["ratio"] >= model["model"]["levels"]["threshold"]
+    plain = stiction.diagnose(pd.read_csv(f), sp="sp", quantify=False)
+    assert "levels" not in next(x for x in plain.to_dict()["families"] if x["family"] == "model")["model"]

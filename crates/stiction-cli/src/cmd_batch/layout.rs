@@ -215,6 +215,7 @@ fn entry(at: String, e: RawEntry, folder: &Path, flags: &Columns) -> Result<Entr
                 ts,
                 integrating,
                 estimate_start: flags.estimate_start,
+                thorough: flags.thorough,
                 mv: blank(e.mv),
                 op_range: flags.op_range,
                 reading: flags.reading.clone(),

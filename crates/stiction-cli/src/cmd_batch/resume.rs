@@ -24,6 +24,9 @@ pub struct LoopSettings {
     pub ts: Option<f64>,
     pub integrating: bool,
     pub estimate_start: bool,
+    /// The levels test (`--thorough`).
+    #[serde(default)]
+    pub thorough: bool,
     pub quantify: bool,
 }
 
@@ -40,6 +43,7 @@ impl LoopSettings {
             ts: c.ts,
             integrating: c.integrating,
             estimate_start: c.estimate_start,
+            thorough: c.thorough,
             quantify,
         }
     }
@@ -170,6 +174,7 @@ mod tests {
             ts: Some(1.0),
             integrating: false,
             estimate_start: false,
+            thorough: false,
             mv: Some("mv".into()),
             op_range: None,
             reading: Default::default(),

@@ -16,3 +16,4 @@ mod limit_cycle;
 mod reading;
 mod render;
 mod report;
+mod thorough;

@@ -88,6 +88,7 @@ def diagnose_many(
     time: Optional[str] = None,
     op_range: Tuple[float, float] = (0.0, 100.0),
     estimate_start: bool = False,
+    thorough: bool = False,
     threads: Optional[int] = None,
     progress: bool = True,
 ) -> pd.DataFrame:
@@ -131,7 +132,7 @@ def diagnose_many(
     text = _native.diagnose_many(
         names, sources, starts.tolist(), sig["op"], sig["pv"], sp=sig["sp"], mv=sig["mv"],
         auto=sig["auto"], time=t, ts=ts, integrating=integrating, quantify=quantify,
-        op_range=tuple(op_range), estimate_start=estimate_start, time_name=time_name,
+        op_range=tuple(op_range), estimate_start=estimate_start, thorough=thorough, time_name=time_name,
         threads=threads, progress=progress, failed={g: f"{sources[g]}: {w}" for g, w in bad.items()},
     )
     rows = json.loads(text)

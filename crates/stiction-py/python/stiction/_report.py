@@ -76,6 +76,7 @@ def report(
     time: Any = None,
     op_range: Tuple[float, float] = (0.0, 100.0),
     estimate_start: bool = False,
+    thorough: bool = False,
 ) -> Path:
     """Diagnose one loop and write its report to ``path``: one self-contained HTML page (inline
     SVG charts and CSS, no scripts or network references), the page ``stiction report`` writes,
@@ -96,7 +97,7 @@ def report(
     html = _native.report(
         cols["op"], cols["pv"], sp=cols["sp"], mv=cols["mv"], auto=cols["auto"], time=cols["time"],
         ts=ts, integrating=integrating, window=window, quantify=quantify,
-        op_range=tuple(op_range), estimate_start=estimate_start, time_name=time_name,
+        op_range=tuple(op_range), estimate_start=estimate_start, thorough=thorough, time_name=time_name,
         loop_id=target.stem if name is None else str(name),
         columns=_names(data, op, pv, sp, mode, time),
     )

@@ -63,6 +63,7 @@ def diagnose(
     time: Optional[str] = None,
     op_range: Any = (0.0, 100.0),
     estimate_start: bool = False,
+    thorough: bool = False,
     rank: bool = True,
 ) -> Any:
     """Diagnose every loop of a long Spark DataFrame (``by`` names the loop): a Spark DataFrame
@@ -82,7 +83,7 @@ def diagnose(
     out_schema = schema(spark_df.schema[by])
     settings = dict(
         op=op, pv=pv, sp=sp, mode=mode, mv=mv, ts=ts, integrating=integrating, quantify=quantify,
-        time=time, op_range=tuple(op_range), estimate_start=estimate_start,
+        time=time, op_range=tuple(op_range), estimate_start=estimate_start, thorough=thorough,
     )
 
     def one_loop(pdf: pd.DataFrame) -> pd.DataFrame:
