@@ -34,6 +34,17 @@ fn benches(c: &mut Criterion) {
             g.bench_function(format!("{name}_{n}_without_quantify"), |b| {
                 b.iter(|| diagnose(black_box(&rec), &indices_only).unwrap())
             });
+            if n == 2000 {
+                // --thorough: the model family's levels test besides (a fit per Stenman valve)
+                let thorough = DiagnoseRequest {
+                    quantify: false,
+                    thorough: true,
+                    ..DiagnoseRequest::default()
+                };
+                g.bench_function(format!("{name}_{n}_thorough_without_quantify"), |b| {
+                    b.iter(|| diagnose(black_box(&rec), &thorough).unwrap())
+                });
+            }
         }
     }
     // the loop family's case (issue 14): a fast loop, Ts = 2 s, a 2 % band, a two-minute cycle

@@ -3,7 +3,7 @@
 //! an external sinusoidal disturbance; noise only), several processes, noise levels and seeds.
 //!
 //!     cargo run --release -p stiction-core --example diagnose_benchmark -- \
-//!         [--isdb ../shared/data/isdb] [--out docs/diagnose-benchmark.md] [--no-quantify] [--verbose]
+//!         [--isdb ../shared/data/isdb] [--out docs/diagnose-benchmark.md] [--no-quantify] [--thorough] [--verbose]
 //!
 //! As `stiction diagnose` does by default, a stiction verdict is checked by the closed-loop
 //! estimate (`--no-quantify` skips it, as the CLI flag of that name does).
@@ -155,6 +155,8 @@ fn main() {
     };
     let verbose = args.iter().any(|a| a == "--verbose");
     let with_quantify = !args.iter().any(|a| a == "--no-quantify");
+    // the model family's levels test besides (`diagnose --thorough`)
+    let thorough = args.iter().any(|a| a == "--thorough");
     let isdb = PathBuf::from(arg("--isdb").unwrap_or_else(|| "../shared/data/isdb".into()));
     // one JSON line per loop: set, loop, truth and the whole diagnosis (for offline analysis)
     let mut jsonl = String::new();
@@ -216,6 +218,7 @@ fn main() {
                 ts: label[idx("Ts")].parse().unwrap_or(1.0),
                 integrating: label[idx("integrating")] == "True",
                 quantify: with_quantify,
+                thorough,
                 ..DiagnoseRequest::default()
             };
             let rec = LoopRecord {
@@ -359,6 +362,7 @@ fn main() {
                     let req = DiagnoseRequest {
                         ts: 1.0,
                         quantify: with_quantify,
+                        thorough,
                         ..DiagnoseRequest::default()
                     };
                     let t = Instant::now();
