@@ -180,6 +180,15 @@ impl EvidenceFamily for Model {
              of the PV's variation above its noise",
             100.0 * MIN_EXPLAINED
         );
+        let threshold = if ctx.req.thorough {
+            format!(
+                "{threshold}; or the levels test's ratio (the best Stenman valve against OP on PV's levels) reaches {LEVELS_STICTION} \
+                 (above all but one of 159 simulated healthy loops), unless OP explains under {:.0} %",
+                100.0 * MIN_EXPLAINED
+            )
+        } else {
+            threshold
+        };
         let Some(f) = &ctx.fits else {
             return FamilyEvidence::abstains(
                 Family::Model,
