@@ -104,7 +104,7 @@ pub struct Columns {
     #[arg(long)]
     pub estimate_start: bool,
     /// Model family: also score every distinct Stenman valve on PV's levels (the levels test;
-    /// finds more sticky valves in records sampled at every controller execution, about a second
+    /// finds more sticky valves in records sampled at every controller execution, 1 to 3 s
     /// a loop of 2,000 samples)
     #[arg(long)]
     pub thorough: bool,

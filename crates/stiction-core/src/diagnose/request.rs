@@ -34,7 +34,7 @@ pub struct DiagnoseRequest {
     pub op_range: [f64; 2],
     /// The model family also runs the levels test ([`crate::identify::levels`]): every distinct
     /// Stenman valve scored on PV's levels. Finds more sticky valves on records sampled at every
-    /// controller execution, at about a second a loop of 2,000 samples.
+    /// controller execution, at 1 to 3 s a loop of 2,000 samples.
     #[serde(default)]
     pub thorough: bool,
 }

@@ -183,7 +183,7 @@ impl EvidenceFamily for Model {
         let threshold = if ctx.req.thorough {
             format!(
                 "{threshold}; or the levels test's ratio (the best Stenman valve against OP on PV's levels) reaches {LEVELS_STICTION} \
-                 (above all but one of 159 simulated healthy loops), unless OP explains under {:.0} %",
+                 (about the 98th percentile of simulated healthy loops), unless OP explains under {:.0} %",
                 100.0 * MIN_EXPLAINED
             )
         } else {
