@@ -32,6 +32,20 @@ pub const TAUS: [f64; 6] = [0.5, 2.0, 6.0, 18.0, 54.0, 160.0];
 pub const DELAYS: [usize; 2] = [3, 8];
 /// Samples between the drift's knots.
 pub const KNOT_EVERY: usize = 150;
+/// A filter bank: first-order filters (time constants, samples) and pure delays (samples).
+#[derive(Debug, Clone, Copy)]
+pub struct Bank<'a> {
+    /// Time constants of the first-order filters, samples.
+    pub taus: &'a [f64],
+    /// Pure delays, samples.
+    pub delays: &'a [usize],
+}
+
+/// The bank the levels test uses.
+pub const BANK: Bank<'static> = Bank {
+    taus: &TAUS,
+    delays: &DELAYS,
+};
 /// Order of the AR noise model.
 pub const AR_ORDER: usize = 4;
 /// The smallest residual a fit reports, share of PV's sum of squares (the arithmetic's
@@ -43,6 +57,8 @@ pub const MIN_SAMPLES: usize = 200;
 /// One record's PV, whitened, with its drift projected out.
 pub struct LevelsFit {
     integrating: bool,
+    taus: Vec<f64>,
+    delays: Vec<usize>,
     /// The whitening filter `A(q)`: coefficients of lags 1.. (empty: white noise).
     ar: Vec<f64>,
     /// Orthonormal basis of the (whitened) drift: a constant and hinges at the knots.
@@ -61,14 +77,20 @@ pub struct Scratch {
 impl LevelsFit {
     /// The fit on `pv`, its noise model estimated on the residual with `op` as the valve.
     pub fn new(pv: &[f64], op: &[f64], integrating: bool) -> Self {
-        let plain = Self::with_noise(pv, integrating, Vec::new());
+        let plain = Self::plain(pv, integrating, BANK);
         let mut scratch = plain.scratch();
         let r = plain.residual(op, &mut scratch);
         let ar = ar_fit(&r, AR_ORDER);
-        Self::with_noise(pv, integrating, ar)
+        Self::with_noise(pv, integrating, BANK, ar)
     }
 
-    fn with_noise(pv: &[f64], integrating: bool, ar: Vec<f64>) -> Self {
+    /// The fit with white noise (no AR model) on a bank of one's own: the plain output-error
+    /// test of the model-family studies (`model_ceiling`, `clean_walk`, `sampled_valve`).
+    pub fn plain(pv: &[f64], integrating: bool, bank: Bank) -> Self {
+        Self::with_noise(pv, integrating, bank, Vec::new())
+    }
+
+    fn with_noise(pv: &[f64], integrating: bool, bank: Bank, ar: Vec<f64>) -> Self {
         let n = pv.len();
         let knots = (n / KNOT_EVERY).max(2);
         let mut cols = vec![vec![1.0; n]];
@@ -90,6 +112,8 @@ impl LevelsFit {
         let yy = dot(&y, &y);
         Self {
             integrating,
+            taus: bank.taus.to_vec(),
+            delays: bank.delays.to_vec(),
             ar,
             drift,
             y,
@@ -100,7 +124,7 @@ impl LevelsFit {
     /// Buffers for [`Self::sse`].
     pub fn scratch(&self) -> Scratch {
         let n = self.y.len();
-        let p = TAUS.len() + DELAYS.len() + usize::from(self.integrating);
+        let p = self.taus.len() + self.delays.len() + usize::from(self.integrating);
         Scratch {
             cols: vec![vec![0.0; n]; p],
             u: vec![0.0; n],
@@ -150,7 +174,7 @@ impl LevelsFit {
         }
         let u = &s.u;
         let mut k = 0;
-        for &tau in &TAUS {
+        for &tau in &self.taus {
             let a = (-1.0f64 / tau).exp();
             let c = &mut s.cols[k];
             let mut state = u[0];
@@ -161,7 +185,7 @@ impl LevelsFit {
             }
             k += 1;
         }
-        for &d in &DELAYS {
+        for &d in &self.delays {
             let c = &mut s.cols[k];
             for t in 0..n {
                 c[t] = if t >= d { u[t - d] } else { 0.0 };
