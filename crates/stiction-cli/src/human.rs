@@ -11,6 +11,7 @@ fn band_source(s: BandSource) -> &'static str {
         BandSource::FitScan => "closed-loop fit's scan",
         BandSource::StickSlip => "median OP travel per stick",
         BandSource::DescribingFunction => "describing function of the limit cycle",
+        BandSource::Levels => "levels test's best valve",
     }
 }
 

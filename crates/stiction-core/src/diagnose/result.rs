@@ -105,6 +105,9 @@ pub enum BandSource {
     /// The band whose describing function closes the harmonic balance of the identified loop at
     /// the observed cycle (the loop family).
     DescribingFunction,
+    /// The best valve of the model family's levels test (`thorough`): every Stenman valve, then
+    /// He's near it, scored on PV's levels.
+    Levels,
 }
 
 impl BandSource {
@@ -116,6 +119,7 @@ impl BandSource {
             BandSource::FitScan => "the closed-loop fit's scan of the Stenman band",
             BandSource::StickSlip => "the median OP travel per stick",
             BandSource::DescribingFunction => "the describing function of the loop's limit cycle",
+            BandSource::Levels => "the levels test's best valve",
         }
     }
 }
@@ -129,6 +133,7 @@ impl BandSource {
             BandSource::FitScan => "fit_scan",
             BandSource::StickSlip => "stick_slip",
             BandSource::DescribingFunction => "describing_function",
+            BandSource::Levels => "levels",
         }
     }
 }

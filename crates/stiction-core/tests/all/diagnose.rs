@@ -1,6 +1,8 @@
 //! The diagnosis: usable stretches, the families of evidence, the verdict, windows.
 
-use stiction_core::diagnose::{diagnose, DiagnoseRequest, Family, LoopRecord, Verdict, Vote};
+use stiction_core::diagnose::{
+    diagnose, BandSource, DiagnoseRequest, Family, LoopRecord, Verdict, Vote,
+};
 use stiction_core::models::{Model, Stenman};
 use stiction_core::quality::Gate;
 use stiction_core::sim::{ClosedLoop, LoopData, Process, Signal};
@@ -333,4 +335,34 @@ fn a_cycle_of_a_few_samples_is_named_not_called_unexcited() {
         q.reason
     );
     assert!(q.next_step.contains("longer record"), "{}", q.next_step);
+}
+
+#[test]
+fn thorough_finds_a_valve_the_fit_of_changes_misses_and_reports_its_band() {
+    // routine-c-0003 of the catalogue's calibration set: a flow loop recorded every second, its
+    // Stenman valve d = 4.53 %; the fit of PV's changes settles on a small band near OP and no
+    // family decides. The levels test finds the valve and the band reported is its own.
+    let l = stiction_core::sim::catalogue::find("routine-c-0003").unwrap();
+    let req = DiagnoseRequest {
+        ts: l.ts(),
+        integrating: l.integrating,
+        ..DiagnoseRequest::default()
+    };
+    let plain = diagnose(&record(&l.data), &req).unwrap();
+    assert_ne!(plain.verdict, Verdict::Stiction, "{:?}", plain.evidence);
+    let thorough = DiagnoseRequest {
+        thorough: true,
+        ..req
+    };
+    let d = diagnose(&record(&l.data), &thorough).unwrap();
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let band = d.band.unwrap();
+    assert_eq!(band.source, BandSource::Levels, "{band:?}");
+    assert!((band.band_percent_of_span - 4.53).abs() < 0.5, "{band:?}");
+    assert!(
+        band.others
+            .iter()
+            .any(|(s, _)| *s == BandSource::ClosedLoop),
+        "{band:?}"
+    );
 }
