@@ -167,9 +167,7 @@ pub(super) fn size(
             band.source.words(),
             band.band_percent_of_span
         ));
-        let fitted = (band.source, band.band_percent_of_span);
-        band = band_of(b, BandSource::DescribingFunction, req);
-        band.others.push(fitted);
+        replace(&mut band, b, BandSource::DescribingFunction, req);
     }
     if let Some(l) = levels {
         if matches!(band.source, BandSource::ClosedLoop | BandSource::FitScan)
@@ -182,9 +180,7 @@ pub(super) fn size(
                 band.source.words(),
                 band.band_percent_of_span
             ));
-            let fitted = (band.source, band.band_percent_of_span);
-            band = band_of(l, BandSource::Levels, req);
-            band.others.push(fitted);
+            replace(&mut band, l, BandSource::Levels, req);
         } else if band.source != BandSource::Levels {
             band.others.push((BandSource::Levels, pct(l)));
         }
@@ -224,6 +220,13 @@ pub(super) fn size(
         }
     }
     d.band = Some(band);
+}
+
+/// Report `by` (OP units, from `source`) instead of `band`, the replaced estimate beside it.
+fn replace(band: &mut Band, by: f64, source: BandSource, req: &DiagnoseRequest) {
+    let replaced = (band.source, band.band_percent_of_span);
+    *band = band_of(by, source, req);
+    band.others.push(replaced);
 }
 
 /// Whether two positive estimates differ by more than `factor` (either way).
