@@ -24,21 +24,18 @@ mod clean_fit;
 #[path = "common/study_args.rs"]
 mod study_args;
 
-use clean_fit::{Bank, CleanFit};
+use clean_fit::CleanFit;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use stiction_core::diagnose::{diagnose, Family, Verdict, Vote};
 use stiction_core::estimate::exact::stenman_walk;
 use stiction_core::identify::levels::LevelsFit;
+/// The filter bank: the levels test's (time constants 0.5-160 samples, delays 3 and 8).
+use stiction_core::identify::levels::BANK;
 use stiction_core::models::Model;
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, Set, Suite, Truth};
 use study_args::StudyArgs;
 
-/// The filter bank (time constants and delays, samples).
-const BANK: Bank = Bank {
-    taus: &[0.5, 2.0, 6.0, 18.0, 54.0, 160.0],
-    delays: &[3, 8],
-};
 /// The ratios reported; [`ADDED`] is the one the "added" verdicts use.
 const SHOWS: [f64; 2] = [20.0, 30.0];
 const ADDED: f64 = 30.0;

@@ -23,20 +23,17 @@ mod clean_fit;
 #[path = "common/study_args.rs"]
 mod study_args;
 
-use clean_fit::{Bank, CleanFit};
+use clean_fit::CleanFit;
 use rayon::prelude::*;
 use std::fmt::Write as _;
+/// The filter bank: the levels test's (time constants 0.5-160 samples, delays 3 and 8).
+use stiction_core::identify::levels::BANK;
 use stiction_core::identify::{self, Data, Structure};
 use stiction_core::models::Model;
 use stiction_core::quantify::{compare_fits, CompareRequest};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, Suite};
 use study_args::StudyArgs;
 
-/// The filter bank (time constants and delays, samples), as `clean_walk`'s.
-const BANK: Bank = Bank {
-    taus: &[0.5, 2.0, 6.0, 18.0, 54.0, 160.0],
-    delays: &[3, 8],
-};
 /// The log-likelihood ratio a trajectory must reach to count as explaining PV.
 const SHOWS: f64 = 30.0;
 /// Valve starts tried across `op[0] ± d`.
