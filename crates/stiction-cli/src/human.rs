@@ -138,7 +138,11 @@ fn record(d: &Diagnosis) {
     if let Some(o) = &d.oscillation {
         println!(
             "  oscillation: {}; period {}; regularity {:.2} (threshold {}); {} half periods with a large IAE",
-            if o.oscillating { "yes" } else { "no" },
+            match (o.oscillating, o.across_setpoint_steps) {
+                (true, true) => "yes, across the setpoint's steps (its holds are too short)",
+                (true, false) => "yes",
+                _ => "no",
+            },
             o.period.map_or("-".into(), |p| format!("{p:.1} s")),
             o.regularity.regularity,
             o.regularity.threshold,

@@ -124,7 +124,10 @@ pub fn oscillation(d: &Diagnosis) -> Option<Vec<KvRow>> {
     Some(vec![
         kv(
             "Oscillating",
-            if o.oscillating {
+            if o.oscillating && o.across_setpoint_steps {
+                "yes: regular and above the noise, across the setpoint's steps (no hold is long enough)"
+                    .to_string()
+            } else if o.oscillating {
                 "yes: regular and above the noise".to_string()
             } else {
                 "no".into()
@@ -132,6 +135,10 @@ pub fn oscillation(d: &Diagnosis) -> Option<Vec<KvRow>> {
         ),
         kv("Period", o.period.map_or("–".into(), duration)),
         kv("Periods in the analysed stretch", opt(o.periods_in_record)),
+        kv(
+            "Share of the error's variance in the cycle",
+            o.cycle_share.map_or("–".into(), |c| format!("{:.0} %", 100.0 * c.max(0.0))),
+        ),
         kv(
             "Regularity (Thornhill)",
             format!(

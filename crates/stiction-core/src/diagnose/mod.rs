@@ -35,7 +35,7 @@ use crate::checked::Checked;
 use crate::quality::{self, Finding, Gate};
 use crate::quantify::{compare_fits, CompareRequest};
 use evidence::Context;
-use oscillation::{constant_setpoint, mean};
+use oscillation::mean;
 use result::Oscillation as Osc;
 use std::time::Instant;
 
@@ -62,8 +62,7 @@ fn control_error(pv: &[f64], sp: Option<&[f64]>) -> Vec<f64> {
 /// Judge one usable stretch (every sample present, automatic).
 fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
     let error = control_error(r.pv, r.sp);
-    let (os, oe) = constant_setpoint(r.sp, (0, r.op.len()));
-    let oscillation = oscillation::oscillation(&error[os..oe], req.ts, (os, oe));
+    let oscillation = oscillation::of_record(&error, r.sp, req.ts);
     let compare = CompareRequest {
         ts: req.ts,
         max_delay: req.max_delay,

@@ -76,6 +76,54 @@ pub(super) fn constant_setpoint(
     best
 }
 
+/// Share of the error's variance in its cycle at which an oscillation across setpoint changes
+/// counts, when the longest constant-setpoint stretch shows none.
+const CYCLE_SHARE_WHOLE: f64 = 0.3;
+
+/// The setpoint moves in steps, in at most [`MAX_SETPOINT_CHANGES`] of the samples (not
+/// continuously, as a cascade inner loop's or a ramp's does: then a cycle may be the setpoint's
+/// own), and no more often than once per period of the cycle on average (so the cycle repeats
+/// within the holds and is not the train of the steps' responses).
+fn setpoint_steps(sp: Option<&[f64]>, periods: Option<f64>) -> bool {
+    let (Some(sp), Some(periods)) = (sp, periods) else {
+        return false;
+    };
+    let changes = sp.windows(2).filter(|w| w[1] != w[0]).count() as f64;
+    changes <= MAX_SETPOINT_CHANGES * sp.len() as f64 && changes <= periods
+}
+
+/// Largest share of samples at which a setpoint that moves in steps changes.
+const MAX_SETPOINT_CHANGES: f64 = 0.02;
+
+/// The oscillation the families judge: on the longest constant-setpoint stretch; where that
+/// shows none and the setpoint moves in steps ([`setpoint_steps`]), across the steps, when the
+/// whole record cycles with at least [`CYCLE_SHARE_WHOLE`] of the error's variance in its cycle
+/// (short holds leave too few cycles between the steps; the steps' own responses are not
+/// periodic). On the catalogue's calibration set this finds 2 more of the sticky routine and
+/// fast loops and calls no look-alike sticky that was not; a third of an oscillation's variance
+/// is about the median share of the sticky routine loops' cycles (0.38), while the healthy loops
+/// that pass for oscillating on their constant-setpoint stretch give about 0.
+pub(super) fn of_record(error: &[f64], sp: Option<&[f64]>, ts: f64) -> Oscillation {
+    let n = error.len();
+    let (os, oe) = constant_setpoint(sp, (0, n));
+    let held = oscillation(&error[os..oe], ts, (os, oe));
+    if held.oscillating || oe - os == n {
+        return held;
+    }
+    let whole = oscillation(error, ts, (0, n));
+    if whole.oscillating
+        && whole.cycle_share.is_some_and(|c| c >= CYCLE_SHARE_WHOLE)
+        && setpoint_steps(sp, whole.periods_in_record)
+    {
+        Oscillation {
+            across_setpoint_steps: true,
+            ..whole
+        }
+    } else {
+        held
+    }
+}
+
 /// The oscillation of the control error `error` (sampled every `ts` s) over `stretch`.
 pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Oscillation {
     let regularity = detect::regularity(error, ts);
@@ -97,6 +145,7 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
     let periods = period.map(|p| error.len() as f64 * ts / p);
     // an oscillation that stands out of the noise, found by either detector (a regular period
     // stands out of noise at a smaller amplitude than a count of large areas)
+    let cycle_share = period.and_then(|p| cycle_share(error, p / ts));
     let oscillating = (regularity.oscillating && iae.exceedances >= 4 && amp > 1.5 * noise)
         || (iae.oscillating && amp > 3.0 * noise);
     Oscillation {
@@ -108,7 +157,26 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
         noise_std: noise,
         amplitude: amp,
         stretch: [stretch.0, stretch.1],
+        across_setpoint_steps: false,
+        cycle_share,
     }
+}
+
+/// Share of the variance of `x` in its cycle of `period` samples, from the autocorrelation: half
+/// its rise from the half period's lag to the period's (a sinusoid in white noise gives its share
+/// of the variance; slow drifts, which raise both lags alike, cancel). `None` when the record
+/// holds fewer than 2 periods or the period is under 2 samples.
+pub(crate) fn cycle_share(x: &[f64], period: f64) -> Option<f64> {
+    if period.is_nan() || period < 2.0 || (x.len() as f64) < 2.0 * period {
+        return None;
+    }
+    let acf = crate::spectral::autocorrelation(x, period.ceil() as usize + 1);
+    let at = |lag: f64| {
+        let k = lag.floor() as usize;
+        let f = lag - k as f64;
+        acf[k] + f * (acf[(k + 1).min(acf.len() - 1)] - acf[k])
+    };
+    Some(0.5 * (at(period) - at(0.5 * period)))
 }
 
 #[cfg(test)]
@@ -123,6 +191,56 @@ mod tests {
         assert_eq!(constant_setpoint(Some(&sp), (0, 100)), (40, 100));
         assert_eq!(constant_setpoint(Some(&sp), (0, 35)), (0, 30));
         assert_eq!(constant_setpoint(None, (5, 9)), (5, 9));
+    }
+
+    /// A sine of `period` samples and unit amplitude in white noise of standard deviation `sigma`.
+    fn sine_in_noise(n: usize, period: f64, sigma: f64) -> Vec<f64> {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(7);
+        (0..n)
+            .map(|k| {
+                let u: f64 = rng.random::<f64>() - 0.5;
+                (std::f64::consts::TAU * k as f64 / period).sin() + sigma * 12f64.sqrt() * u
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_cycle_share_of_a_sine_in_noise_is_its_share_of_the_variance() {
+        // variance 0.5 of the sine beside 0.5 of the noise: half
+        let x = sine_in_noise(4000, 40.0, 0.5f64.sqrt());
+        let c = cycle_share(&x, 40.0).unwrap();
+        assert!((c - 0.5).abs() < 0.05, "{c}");
+        // a slow drift raises the period's lag and the half period's alike
+        let drift: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(k, v)| v + 0.002 * k as f64)
+            .collect();
+        assert!(cycle_share(&drift, 40.0).unwrap() < 0.6);
+        assert!(cycle_share(&x[..60], 40.0).is_none());
+    }
+
+    #[test]
+    fn a_cycle_across_setpoint_steps_counts_unless_the_setpoint_moves_all_the_time() {
+        // the setpoint steps every 60 samples: no hold has two whole cycles of 40 samples
+        let n = 2000;
+        let cycle = sine_in_noise(n, 40.0, 0.2);
+        let steps: Vec<f64> = (0..n).map(|k| 50.0 + ((k / 60) % 3) as f64).collect();
+        let error: Vec<f64> = cycle.clone();
+        let o = of_record(&error, Some(&steps), 1.0);
+        assert!(o.oscillating && o.across_setpoint_steps, "{o:?}");
+        assert_eq!(o.stretch, [0, n]);
+        assert!((o.period.unwrap() - 40.0).abs() < 2.0);
+        // a setpoint that moves at every sample (a cascade's inner loop): the cycle may be its own
+        let moving: Vec<f64> = (0..n).map(|k| 50.0 + 0.001 * k as f64).collect();
+        let o = of_record(&error, Some(&moving), 1.0);
+        assert!(!o.across_setpoint_steps, "{o:?}");
+        // steps more often than the cycle: the train of their responses, not a cycle
+        let fast: Vec<f64> = (0..n).map(|k| 50.0 + ((k / 30) % 2) as f64).collect();
+        assert!(!setpoint_steps(Some(&fast), Some(50.0)));
+        assert!(setpoint_steps(Some(&steps), Some(50.0)));
+        assert!(!setpoint_steps(None, Some(50.0)));
     }
 
     #[test]

@@ -85,9 +85,19 @@ pub struct Oscillation {
     pub noise_std: f64,
     /// Half the peak-to-peak amplitude of the control error (5th to 95th percentile).
     pub amplitude: f64,
-    /// The samples `[start, end)` the oscillation was judged on (the longest stretch with a
-    /// constant setpoint).
+    /// The samples `[start, end)` the oscillation was judged on: the longest stretch with a
+    /// constant setpoint, or the whole stretch across the setpoint's steps
+    /// (`across_setpoint_steps`).
     pub stretch: [usize; 2],
+    /// The oscillation was judged across the setpoint's steps: the longest constant-setpoint
+    /// stretch showed none, while the whole stretch cycles, with at least 30 % of the error's
+    /// variance in the cycle, and the setpoint moves in steps no more often than once a period.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub across_setpoint_steps: bool,
+    /// Share of the control error's variance in its cycle (from the autocorrelation at the period
+    /// and half of it), when a period was found.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle_share: Option<f64>,
 }
 
 /// Where the band in the verdict comes from.

@@ -366,3 +366,15 @@ fn thorough_finds_a_valve_the_fit_of_changes_misses_and_reports_its_band() {
         "{band:?}"
     );
 }
+
+#[test]
+fn a_cycle_across_short_setpoint_holds_is_judged_across_them() {
+    // routine-c-0218 of the catalogue's calibration set: a level loop whose He valve (fs = 2.81 %)
+    // cycles every 6 minutes while the setpoint steps every 4-8 minutes. No hold has two whole
+    // cycles; across the steps the loop's own cycle is judged, and the families name the valve.
+    let d = judge_catalogue("routine-c-0218");
+    let o = d.oscillation.clone().unwrap();
+    assert!(o.oscillating && o.across_setpoint_steps, "{o:?}");
+    assert_eq!(o.stretch, [0, d.samples]);
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+}

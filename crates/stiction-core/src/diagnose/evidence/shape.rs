@@ -45,8 +45,13 @@ impl EvidenceFamily for Shape {
                 )
             } else {
                 format!(
-                    "only {periods:.1} oscillation periods (of {:.0} s) with a constant setpoint; the indices need {}",
+                    "only {periods:.1} oscillation periods (of {:.0} s) {}; the indices need {}",
                     osc.period.unwrap_or(0.0),
+                    if osc.across_setpoint_steps {
+                        "across the setpoint's steps"
+                    } else {
+                        "with a constant setpoint"
+                    },
                     ctx.req.min_periods
                 )
             };
