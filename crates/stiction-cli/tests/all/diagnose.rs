@@ -461,3 +461,68 @@ fn bad_input_is_one_clear_sentence() {
         &["empty.csv", "no data rows"],
     );
 }
+
+/// A Stenman band of 2 (or a healthy valve) in the default loop, 2,000 samples, the setpoint
+/// stepping every 150 s: no hold has two of the sticky loop's cycles (about 105 s).
+fn short_holds(dir: &Path, d: &str) -> String {
+    let p = dir.join(format!("holds_{d}.csv"));
+    let param = format!("d={d}");
+    let sp = "steps:amplitude=1,hold=150,offset=50,seed=1";
+    let path = p.to_str().unwrap();
+    ok(&[
+        "simulate",
+        "--loop",
+        "closed",
+        "--param",
+        &param,
+        "--noise",
+        "0.05",
+        "--seed",
+        "3",
+        "--sp",
+        sp,
+        "--samples",
+        "2000",
+        "-o",
+        path,
+    ]);
+    path.to_string()
+}
+
+#[test]
+fn a_cycle_across_short_setpoint_holds_is_judged_across_them_and_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = short_holds(dir.path(), "2");
+    let v = json(&ok(&[
+        "diagnose",
+        &f,
+        "--sp",
+        "sp",
+        "--no-quantify",
+        "--json",
+    ]));
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    let o = &v["oscillation"];
+    assert_eq!(o["oscillating"], true, "{o:#}");
+    assert_eq!(o["across_setpoint_steps"], true, "{o:#}");
+    assert_eq!(o["stretch"], serde_json::json!([0, 2000]), "{o:#}");
+    assert!(o["cycle_share"].as_f64().unwrap() >= 0.3, "{o:#}");
+    let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
+    assert!(text.contains("across the setpoint's steps"), "{text}");
+    // the same loop with a healthy valve has no cycle to find across its steps
+    let h = short_holds(dir.path(), "0");
+    let v = json(&ok(&[
+        "diagnose",
+        &h,
+        "--sp",
+        "sp",
+        "--no-quantify",
+        "--json",
+    ]));
+    assert_ne!(v["verdict"], "stiction", "{v:#}");
+    assert!(
+        v["oscillation"].get("across_setpoint_steps").is_none(),
+        "{:#}",
+        v["oscillation"]
+    );
+}
