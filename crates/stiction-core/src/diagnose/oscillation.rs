@@ -146,9 +146,9 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
     };
     let iae = detect::iae_count(error, ts, &settings);
     let periods = period.map(|p| error.len() as f64 * ts / p);
+    let cycle_share = period.and_then(|p| cycle_share(error, p / ts));
     // an oscillation that stands out of the noise, found by either detector (a regular period
     // stands out of noise at a smaller amplitude than a count of large areas)
-    let cycle_share = period.and_then(|p| cycle_share(error, p / ts));
     let oscillating = (regularity.oscillating && iae.exceedances >= 4 && amp > 1.5 * noise)
         || (iae.oscillating && amp > 3.0 * noise);
     Oscillation {
@@ -169,7 +169,7 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
 /// its rise from the half period's lag to the period's (a sinusoid in white noise gives its share
 /// of the variance; slow drifts, which raise both lags alike, cancel). `None` when the record
 /// holds fewer than 2 periods or the period is under 2 samples.
-pub(crate) fn cycle_share(x: &[f64], period: f64) -> Option<f64> {
+fn cycle_share(x: &[f64], period: f64) -> Option<f64> {
     if period.is_nan() || period < 2.0 || (x.len() as f64) < 2.0 * period {
         return None;
     }
@@ -230,14 +230,13 @@ mod tests {
         let n = 2000;
         let cycle = sine_in_noise(n, 40.0, 0.2);
         let steps: Vec<f64> = (0..n).map(|k| 50.0 + ((k / 60) % 3) as f64).collect();
-        let error: Vec<f64> = cycle.clone();
-        let o = of_record(&error, Some(&steps), 1.0);
+        let o = of_record(&cycle, Some(&steps), 1.0);
         assert!(o.oscillating && o.across_setpoint_steps, "{o:?}");
         assert_eq!(o.stretch, [0, n]);
         assert!((o.period.unwrap() - 40.0).abs() < 2.0);
         // a setpoint that moves at every sample (a cascade's inner loop): the cycle may be its own
         let moving: Vec<f64> = (0..n).map(|k| 50.0 + 0.001 * k as f64).collect();
-        let o = of_record(&error, Some(&moving), 1.0);
+        let o = of_record(&cycle, Some(&moving), 1.0);
         assert!(!o.across_setpoint_steps, "{o:?}");
         // steps more often than the cycle: the train of their responses, not a cycle
         let fast: Vec<f64> = (0..n).map(|k| 50.0 + ((k / 30) % 2) as f64).collect();
