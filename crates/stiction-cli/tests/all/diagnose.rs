@@ -492,15 +492,18 @@ fn short_holds(dir: &Path, d: &str) -> String {
 #[test]
 fn a_cycle_across_short_setpoint_holds_is_judged_across_them_and_said() {
     let dir = tempfile::tempdir().unwrap();
+    let judge = |f: &str| {
+        json(&ok(&[
+            "diagnose",
+            f,
+            "--sp",
+            "sp",
+            "--no-quantify",
+            "--json",
+        ]))
+    };
     let f = short_holds(dir.path(), "2");
-    let v = json(&ok(&[
-        "diagnose",
-        &f,
-        "--sp",
-        "sp",
-        "--no-quantify",
-        "--json",
-    ]));
+    let v = judge(&f);
     assert_eq!(v["verdict"], "stiction", "{v:#}");
     let o = &v["oscillation"];
     assert_eq!(o["oscillating"], true, "{o:#}");
@@ -510,19 +513,8 @@ fn a_cycle_across_short_setpoint_holds_is_judged_across_them_and_said() {
     let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
     assert!(text.contains("across the setpoint's steps"), "{text}");
     // the same loop with a healthy valve has no cycle to find across its steps
-    let h = short_holds(dir.path(), "0");
-    let v = json(&ok(&[
-        "diagnose",
-        &h,
-        "--sp",
-        "sp",
-        "--no-quantify",
-        "--json",
-    ]));
+    let v = judge(&short_holds(dir.path(), "0"));
     assert_ne!(v["verdict"], "stiction", "{v:#}");
-    assert!(
-        v["oscillation"].get("across_setpoint_steps").is_none(),
-        "{:#}",
-        v["oscillation"]
-    );
+    let o = &v["oscillation"];
+    assert!(o.get("across_setpoint_steps").is_none(), "{o:#}");
 }
