@@ -17,8 +17,9 @@
 //! the band's range) and keeps the best; then He's valve (a slip that lands short of OP, as
 //! Kano's slip jump below the band) at a few bands and landings around it. On the calibration
 //! set the He valves found 15 more of the 240 sticky routine loops and 12 more of the 90 fast
-//! ones, and one more of 159 healthy routine loops and one of 136 fast ones reached 50. It costs a fit per trajectory (about a thousand on 2,000
-//! samples), so `diagnose` runs it only when asked (`thorough`).
+//! ones, and one more of 159 healthy routine loops and one of 136 fast ones reached 50. It costs a fit per trajectory (a few thousand on 2,000
+//! samples; the walk runs in fixed chunks in parallel, and its result is the walk in order's, on
+//! any number of threads), so `diagnose` runs it only when asked (`thorough`).
 
 // small dense linear algebra reads best with the textbook's indices
 #![allow(clippy::needless_range_loop)]
@@ -239,22 +240,12 @@ pub fn levels_walk(op: &[f64], pv: &[f64], integrating: bool) -> Option<LevelsWa
     let fit = LevelsFit::new(pv, op, integrating);
     let mut scratch = fit.scratch();
     let with_op = fit.sse(op, &mut scratch);
-    let (mut best, mut band, mut trajectories) = (with_op, 0.0, 0);
+    let (best_walk, trajectories) = walk_chunks(&fit, op, range);
+    let (mut best, mut band) = match best_walk {
+        Some((s, cell)) if s < with_op => (s, 0.5 * (cell.0 + cell.1)),
+        _ => (with_op, 0.0),
+    };
     let mut valve = vec![0.0; n];
-    stenman_walk(
-        op,
-        op[0],
-        (range * 1e-4, range),
-        (0.0, range * (1.0 + 1e-9)),
-        &mut valve,
-        |cell, mv| {
-            trajectories += 1;
-            let s = fit.sse(mv, &mut scratch);
-            if s < best {
-                (best, band) = (s, 0.5 * (cell.0 + cell.1));
-            }
-        },
-    );
     // a slip that lands short of OP (He's dynamic friction fd, Kano's slip jump below the band)
     // near the best band: a few fits beside the walk's thousands
     let mut slip_short = 0.0;
@@ -283,6 +274,88 @@ pub fn levels_walk(op: &[f64], pv: &[f64], integrating: bool) -> Option<LevelsWa
         slip_short,
         trajectories,
     })
+}
+
+/// Chunks the band's range is cut into (geometric), walked in parallel; the result is the
+/// sequential walk's, whatever the number of threads.
+const WALK_CHUNKS: usize = 32;
+
+/// What one chunk's walk found: its best piece of a cell and that piece's error, its first and
+/// last pieces' errors (a cell that crosses the chunk's edge is walked in two pieces, one in each
+/// chunk, with the same trajectory and so the same error), and the pieces walked.
+struct ChunkWalk {
+    best: Option<Piece>,
+    first: Option<Piece>,
+    last: Option<Piece>,
+    pieces: usize,
+}
+
+/// A walked piece of a cell: the error of its trajectory and the piece's bands.
+type Piece = (f64, (f64, f64));
+
+/// Every distinct Stenman trajectory of bands in `[range 10⁻⁴, range)`, walked in fixed chunks
+/// in parallel: the best trajectory's error and whole cell (the first in order of the band
+/// among equals, as a walk in order keeps), and the number of distinct trajectories.
+fn walk_chunks(fit: &LevelsFit, op: &[f64], range: f64) -> (Option<Piece>, usize) {
+    use rayon::prelude::*;
+    let (first, hi) = (range * 1e-4, range);
+    let mut edges: Vec<f64> = (0..=WALK_CHUNKS)
+        .map(|i| first * (hi / first).powf(i as f64 / WALK_CHUNKS as f64))
+        .collect();
+    edges[0] = first;
+    edges[WALK_CHUNKS] = hi;
+    let walks: Vec<ChunkWalk> = edges
+        .par_windows(2)
+        .map_init(
+            || (fit.scratch(), vec![0.0; op.len()]),
+            |(scratch, valve), w| {
+                let mut c = ChunkWalk {
+                    best: None,
+                    first: None,
+                    last: None,
+                    pieces: 0,
+                };
+                let whole = (0.0, range * (1.0 + 1e-9));
+                stenman_walk(op, op[0], (w[0], w[1]), whole, valve, |cell, mv| {
+                    let s = fit.sse(mv, scratch);
+                    c.pieces += 1;
+                    if c.best.is_none_or(|b| s < b.0) {
+                        c.best = Some((s, cell));
+                    }
+                    if c.first.is_none() {
+                        c.first = Some((s, cell));
+                    }
+                    c.last = Some((s, cell));
+                });
+                c
+            },
+        )
+        .collect();
+    // a piece whose error equals the next chunk's first piece's is one cell split at the edge
+    let split = |i: usize| match (walks[i].last, walks.get(i + 1).and_then(|w| w.first)) {
+        (Some(a), Some(b)) => a.0 == b.0 && a.1 .1 == b.1 .0,
+        _ => false,
+    };
+    let trajectories = walks.iter().map(|w| w.pieces).sum::<usize>()
+        - (0..walks.len()).filter(|&i| split(i)).count();
+    let mut best: Option<(f64, (f64, f64), usize)> = None;
+    for (i, w) in walks.iter().enumerate() {
+        if let Some((s, cell)) = w.best {
+            if best.is_none_or(|b| s < b.0) {
+                best = Some((s, cell, i));
+            }
+        }
+    }
+    let best = best.map(|(s, cell, mut i)| {
+        // the best piece ends at its chunk's edge: the cell goes on into the next chunks
+        let mut piece = cell;
+        while walks[i].last.is_some_and(|l| l.1 == piece) && split(i) {
+            piece = walks[i + 1].first.map_or(piece, |f| f.1);
+            i += 1;
+        }
+        (s, (cell.0, piece.1))
+    });
+    (best, trajectories)
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -438,6 +511,48 @@ mod tests {
         (0..n)
             .map(|t| 50.0 + 8.0 * (t as f64 * 0.013).sin() + 0.3 * (t as f64 * 0.71).sin())
             .collect()
+    }
+
+    /// The walk in order of the band, in one piece: the reference the chunked walk must equal.
+    fn walk_in_order(fit: &LevelsFit, op: &[f64], range: f64) -> (Option<Piece>, usize) {
+        let mut scratch = fit.scratch();
+        let mut valve = vec![0.0; op.len()];
+        let (mut best, mut count) = (None::<Piece>, 0);
+        let whole = (0.0, range * (1.0 + 1e-9));
+        stenman_walk(
+            op,
+            op[0],
+            (range * 1e-4, range),
+            whole,
+            &mut valve,
+            |cell, mv| {
+                count += 1;
+                let s = fit.sse(mv, &mut scratch);
+                if best.is_none_or(|b| s < b.0) {
+                    best = Some((s, cell));
+                }
+            },
+        );
+        (best, count)
+    }
+
+    #[test]
+    fn the_chunked_walk_equals_the_walk_in_order() {
+        let op = ramp_op(600);
+        let range = 16.6;
+        for (d, seed) in [(0.0, 1), (0.4, 2), (2.0, 3), (6.0, 4)] {
+            let valve = if d > 0.0 {
+                Model::Stenman(Stenman::new(d).unwrap()).simulate(&op)
+            } else {
+                op.clone()
+            };
+            let fit = LevelsFit::new(&process(&valve, 0.05, seed), &op, false);
+            let (a, b) = (
+                walk_chunks(&fit, &op, range),
+                walk_in_order(&fit, &op, range),
+            );
+            assert_eq!(a, b, "d = {d}");
+        }
     }
 
     #[test]
