@@ -96,7 +96,11 @@ pub fn autocorrelation(x: &[f64], max_lag: usize) -> Vec<f64> {
 
 /// Regularity of the oscillation in `error` sampled every `ts` seconds.
 pub fn regularity(error: &[f64], ts: f64) -> Regularity {
-    let acf = autocorrelation(error, error.len() / 2);
+    regularity_of(&autocorrelation(error, error.len() / 2), ts)
+}
+
+/// [`regularity`] from the error's autocorrelation for lags up to half its length.
+pub(crate) fn regularity_of(acf: &[f64], ts: f64) -> Regularity {
     // zero crossings, interpolated between lags
     let mut crossings = Vec::new();
     for k in 1..acf.len() {

@@ -129,7 +129,8 @@ pub(super) fn of_record(error: &[f64], sp: Option<&[f64]>, ts: f64) -> Oscillati
 
 /// The oscillation of the control error `error` (sampled every `ts` s) over `stretch`.
 pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Oscillation {
-    let regularity = detect::regularity(error, ts);
+    let acf = detect::autocorrelation(error, error.len() / 2);
+    let regularity = detect::regularity_of(&acf, ts);
     let noise = crate::detect::measurement_noise(error);
     let amp = amplitude(error);
     let period = regularity.period;
@@ -146,7 +147,7 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
     };
     let iae = detect::iae_count(error, ts, &settings);
     let periods = period.map(|p| error.len() as f64 * ts / p);
-    let cycle_share = period.and_then(|p| cycle_share(error, p / ts));
+    let cycle_share = period.and_then(|p| cycle_share(&acf, error.len(), p / ts));
     // an oscillation that stands out of the noise, found by either detector (a regular period
     // stands out of noise at a smaller amplitude than a count of large areas)
     let oscillating = (regularity.oscillating && iae.exceedances >= 4 && amp > 1.5 * noise)
@@ -165,17 +166,17 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
     }
 }
 
-/// Share of the variance of `x` in its cycle of `period` samples, from the autocorrelation: half
-/// its rise from the half period's lag to the period's (a sinusoid in white noise gives its share
-/// of the variance; slow drifts, which raise both lags alike, cancel). `None` when the record
-/// holds fewer than 2 periods or the period is under 2 samples.
-fn cycle_share(x: &[f64], period: f64) -> Option<f64> {
-    if period.is_nan() || period < 2.0 || (x.len() as f64) < 2.0 * period {
+/// Share of the variance of a record of `samples` samples in its cycle of `period` samples, from
+/// its autocorrelation `acf` (lags up to half the record, as [`detect::regularity`] takes it):
+/// half its rise from the half period's lag to the period's (a sinusoid in white noise gives its
+/// share of the variance; slow drifts, which raise both lags alike, cancel). `None` when the
+/// record holds fewer than 2 periods or the period is under 2 samples.
+fn cycle_share(acf: &[f64], samples: usize, period: f64) -> Option<f64> {
+    if period.is_nan() || period < 2.0 || (samples as f64) < 2.0 * period || acf.is_empty() {
         return None;
     }
-    let acf = crate::spectral::autocorrelation(x, period.ceil() as usize + 1);
     let at = |lag: f64| {
-        let k = lag.floor() as usize;
+        let k = (lag.floor() as usize).min(acf.len() - 1);
         let f = lag - k as f64;
         acf[k] + f * (acf[(k + 1).min(acf.len() - 1)] - acf[k])
     };
@@ -212,7 +213,9 @@ mod tests {
     fn the_cycle_share_of_a_sine_in_noise_is_its_share_of_the_variance() {
         // variance 0.5 of the sine beside 0.5 of the noise: half
         let x = sine_in_noise(4000, 40.0, 0.5f64.sqrt());
-        let c = cycle_share(&x, 40.0).unwrap();
+        let share =
+            |x: &[f64]| cycle_share(&detect::autocorrelation(x, x.len() / 2), x.len(), 40.0);
+        let c = share(&x).unwrap();
         assert!((c - 0.5).abs() < 0.05, "{c}");
         // a slow drift raises the period's lag and the half period's alike
         let drift: Vec<f64> = x
@@ -220,8 +223,8 @@ mod tests {
             .enumerate()
             .map(|(k, v)| v + 0.002 * k as f64)
             .collect();
-        assert!(cycle_share(&drift, 40.0).unwrap() < 0.6);
-        assert!(cycle_share(&x[..60], 40.0).is_none());
+        assert!(share(&drift).unwrap() < 0.6);
+        assert!(share(&x[..60]).is_none());
     }
 
     #[test]

@@ -304,6 +304,7 @@ fn walk_chunks(fit: &LevelsFit, op: &[f64], range: f64) -> (Option<Piece>, usize
         .collect();
     edges[0] = first;
     edges[WALK_CHUNKS] = hi;
+    let whole = (0.0, range * (1.0 + 1e-9));
     let walks: Vec<ChunkWalk> = edges
         .par_windows(2)
         .map_init(
@@ -315,7 +316,6 @@ fn walk_chunks(fit: &LevelsFit, op: &[f64], range: f64) -> (Option<Piece>, usize
                     last: None,
                     pieces: 0,
                 };
-                let whole = (0.0, range * (1.0 + 1e-9));
                 stenman_walk(op, op[0], (w[0], w[1]), whole, valve, |cell, mv| {
                     let s = fit.sse(mv, scratch);
                     c.pieces += 1;
