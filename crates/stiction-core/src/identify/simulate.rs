@@ -57,43 +57,57 @@ pub(super) fn simulate_n<const NA: usize, const NB: usize>(
     bound: f64,
 ) -> f64 {
     let n = y.len();
-    // the last NA simulated outputs, newest first
-    let mut sim: [f64; NA] = std::array::from_fn(|i| y[t0 - 1 - i]);
+    // the last two simulated outputs (y[k-1], y[k-2]; a missing order's is never read)
+    let mut y1 = if NA > 0 { y[t0 - 1] } else { 0.0 };
+    let mut y2 = if NA > 1 { y[t0 - 2] } else { 0.0 };
     if let Some(o) = out.as_deref_mut() {
         o.clear();
         o.extend_from_slice(&y[..t0]);
     }
-    let mut sse = 0.0;
+    let (a0, a1) = (
+        if NA > 0 { a[0] } else { 0.0 },
+        if NA > 1 { a[1] } else { 0.0 },
+    );
+    // two samples per step, both from the two outputs before them:
+    //   y[k]   = u[k] + a0 y[k-1] + a1 y[k-2]
+    //   y[k+1] = u[k+1] + a0 u[k] + (a0² + a1) y[k-1] + a0 a1 y[k-2]
+    // so the recursion's critical path is one multiply-add per two samples, not per sample
+    let (p1, p2) = (a0 * a0 + a1, a0 * a1);
     let len = n - t0;
     let ms: [&[f64]; NB] = std::array::from_fn(|j| &mv[t0 - nk - j..t0 - nk - j + len]);
     let target = &y[t0..n];
-    for k in 0..len {
-        // everything but the newest simulated output first: the recursion's critical path is
-        // then one multiply-add per sample
-        let mut v = c;
+    let input = |k: usize| {
+        let mut u = c;
         for j in 0..NB {
-            v += b[j] * ms[j][k];
+            u += b[j] * ms[j][k];
         }
-        for i in (1..NA).rev() {
-            v += a[i] * sim[i];
+        u
+    };
+    let mut sse = 0.0;
+    let mut k = 0;
+    while k + 1 < len {
+        let (u0, u1) = (input(k), input(k + 1));
+        let v0 = (u0 + a1 * y2) + a0 * y1;
+        let v1 = (u1 + a0 * u0 + p2 * y2) + p1 * y1;
+        let (e0, e1) = (target[k] - v0, target[k + 1] - v1);
+        sse += e0 * e0 + e1 * e1;
+        if let Some(o) = out.as_deref_mut() {
+            o.push(v0);
+            o.push(v1);
         }
-        if NA > 0 {
-            v += a[0] * sim[0];
+        (y2, y1) = (v0, v1);
+        k += 2;
+        // checked every 64 samples: cheap, and most wrong trajectories are out within a few hundred
+        if k % 64 == 0 && sse > bound {
+            return f64::INFINITY;
         }
-        for i in (1..NA).rev() {
-            sim[i] = sim[i - 1];
-        }
-        if NA > 0 {
-            sim[0] = v;
-        }
+    }
+    if k < len {
+        let v = (input(k) + a1 * y2) + a0 * y1;
         let e = target[k] - v;
         sse += e * e;
         if let Some(o) = out.as_deref_mut() {
             o.push(v);
-        }
-        // checked every 64 samples: cheap, and most wrong trajectories are out within a few hundred
-        if k % 64 == 63 && sse > bound {
-            return f64::INFINITY;
         }
     }
     if sse.is_finite() {
