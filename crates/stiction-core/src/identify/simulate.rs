@@ -106,7 +106,7 @@ pub(super) fn simulate_n<const NA: usize, const NB: usize>(
         let v = (input(k) + a1 * y2) + a0 * y1;
         let e = target[k] - v;
         sse += e * e;
-        if let Some(o) = out.as_deref_mut() {
+        if let Some(o) = out {
             o.push(v);
         }
     }
