@@ -518,3 +518,59 @@ fn a_cycle_across_short_setpoint_holds_is_judged_across_them_and_said() {
     let o = &v["oscillation"];
     assert!(o.get("across_setpoint_steps").is_none(), "{o:#}");
 }
+
+/// Issue 10's integrating loop, typed as the issue types it: `simulate --loop closed --param d=D
+/// --process integrating:K=0.05,delay=5 --noise 0.05`.
+fn integrating_loop(dir: &Path, d: &str) -> String {
+    let p = dir.join(format!("integrating_{d}.csv"));
+    let path = p.to_str().unwrap();
+    ok(&[
+        "simulate",
+        "--loop",
+        "closed",
+        "--param",
+        &format!("d={d}"),
+        "--process",
+        "integrating:K=0.05,delay=5",
+        "--noise",
+        "0.05",
+        "-o",
+        path,
+    ]);
+    path.to_string()
+}
+
+#[test]
+fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
+    // its cycle lasts about as long as the changes the closed-loop fit compares: differenced over
+    // a whole period, the cycle (and the valve that drives it) cancelled, and the fit with
+    // stiction did worse than the linear loop (`no_stiction`, while `quantify` found d = 2.0)
+    let dir = tempfile::tempdir().unwrap();
+    let judge = |f: &str| json(&ok(&["diagnose", f, "--sp", "sp", "--json"]));
+    let v = judge(&integrating_loop(dir.path(), "2"));
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    let model = v["families"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["family"] == "model")
+        .unwrap();
+    assert_eq!(model["vote"], "stiction", "{model:#}");
+    let m = &model["model"];
+    let (period, lag) = (
+        v["oscillation"]["period"].as_f64().unwrap(),
+        m["lag"].as_f64().unwrap(),
+    );
+    let kept = 2.0 * (std::f64::consts::PI * lag / period).sin().abs();
+    assert!(
+        kept >= 0.5,
+        "lag {lag} s keeps {kept} of the {period} s cycle"
+    );
+    assert!(
+        (m["stenman_d"].as_f64().unwrap() - 2.0).abs() < 0.2,
+        "{m:#}"
+    );
+    // the same loop with a healthy valve
+    let v = judge(&integrating_loop(dir.path(), "0"));
+    assert_ne!(v["verdict"], "stiction", "{v:#}");
+}

@@ -67,6 +67,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         ts: req.ts,
         max_delay: req.max_delay,
         integrating: Some(req.integrating),
+        lag: None,
     };
     let ctx = Context {
         req,

@@ -19,6 +19,7 @@
 
 mod band;
 mod dependence;
+mod lag;
 pub use dependence::correlation_span;
 
 use super::problem::{difference, range};
@@ -26,6 +27,7 @@ use crate::detect::measurement_noise;
 use crate::identify::{self, Data, Fit, SearchRange, Structure};
 use crate::models::{Kano, Model, Stenman};
 use band::{exact_band, valve_start};
+use lag::{half_correlation, off_the_cycle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -38,6 +40,10 @@ pub struct CompareRequest {
     pub max_delay: usize,
     /// `Some(true)`: integrating process only; `Some(false)`: self-regulating only; `None`: both.
     pub integrating: Option<bool>,
+    /// The lag of the changes compared, samples, when the caller sets it (within the bounds the
+    /// record allows); `None`: from the process's response time, off the PV's cycle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lag: Option<usize>,
 }
 
 impl Default for CompareRequest {
@@ -46,6 +52,7 @@ impl Default for CompareRequest {
             ts: 1.0,
             max_delay: 30,
             integrating: None,
+            lag: None,
         }
     }
 }
@@ -254,7 +261,11 @@ impl Setup {
             // a level's change grows with the lag while its noise does not: a long lag
             lag = lag.max(n / INTEGRATING_LAG_SHARE);
         }
-        let lag = lag.clamp(MIN_LAG, (n / MAX_LAG_SHARE).max(MIN_LAG));
+        let max_lag = (n / MAX_LAG_SHARE).max(MIN_LAG);
+        let lag = match req.lag {
+            Some(l) => l.clamp(MIN_LAG, max_lag),
+            None => off_the_cycle(lag.clamp(MIN_LAG, max_lag), pv, max_lag),
+        };
         if n < lag + t0 + 20 * (search.na.len() + search.nb_max + 1) {
             return None;
         }
@@ -440,26 +451,6 @@ impl Fits {
             op_offset: setup.offset,
         }
     }
-}
-
-/// The first lag at which the autocorrelation of the PV (its straight-line trend removed) falls
-/// below one half: about the time the loop takes to forget where PV was.
-fn half_correlation(pv: &[f64]) -> usize {
-    let n = pv.len();
-    let (tm, ym) = ((n as f64 - 1.0) / 2.0, pv.iter().sum::<f64>() / n as f64);
-    let (mut stt, mut sty) = (0.0, 0.0);
-    for (t, y) in pv.iter().enumerate() {
-        stt += (t as f64 - tm).powi(2);
-        sty += (t as f64 - tm) * (y - ym);
-    }
-    let slope = if stt > 0.0 { sty / stt } else { 0.0 };
-    let x: Vec<f64> = pv
-        .iter()
-        .enumerate()
-        .map(|(t, y)| y - ym - slope * (t as f64 - tm))
-        .collect();
-    let acf = crate::detect::autocorrelation(&x, n / MAX_LAG_SHARE);
-    acf.iter().position(|&r| r < 0.5).unwrap_or(acf.len())
 }
 
 /// A structure, then the same delay and family with the other orders: an equation-error fit of a
