@@ -1,5 +1,6 @@
 //! The diagnosis: usable stretches, the families of evidence, the verdict, windows.
 
+use stiction_core::diagnose::evidence::model::CYCLE_CANCELLED_STICTION;
 use stiction_core::diagnose::{
     diagnose, BandSource, DiagnoseRequest, Family, LoopRecord, Verdict, Vote,
 };
@@ -377,4 +378,44 @@ fn a_cycle_across_short_setpoint_holds_is_judged_across_them() {
     assert!(o.oscillating && o.across_setpoint_steps, "{o:?}");
     assert_eq!(o.stretch, [0, d.samples]);
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+}
+
+#[test]
+fn a_limit_cycle_whose_fits_look_alike_is_compared_over_whole_periods() {
+    // fast-c-0069 of the catalogue's calibration set: a flow loop tuned at 0.99 of its ultimate
+    // gain, its He valve (fs = 4.16 %) limit-cycling every 12 s. Over a response time the fits
+    // with and without stiction look alike; over a whole period the cycle cancels, and the valve
+    // explains what is left far better than OP
+    let d = judge_catalogue("fast-c-0069");
+    let model = d
+        .families
+        .iter()
+        .find(|f| f.family == Family::Model)
+        .unwrap();
+    let c = model
+        .model
+        .as_ref()
+        .unwrap()
+        .cycle_cancelled
+        .clone()
+        .unwrap();
+    assert!(c.significance >= CYCLE_CANCELLED_STICTION, "{c:?}");
+    assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
+    assert!(model.note.contains("whole period"), "{}", model.note);
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    // healthy valves: a loop at its stability limit (fast-c-0151, 0.97 of the ultimate gain) and
+    // an external sinusoid (fast-c-0126) reach the same comparison, and the valve explains nothing
+    for id in ["fast-c-0151", "fast-c-0126"] {
+        let d = judge_catalogue(id);
+        let model = d
+            .families
+            .iter()
+            .find(|f| f.family == Family::Model)
+            .unwrap();
+        let c = model.model.as_ref().unwrap().cycle_cancelled.clone();
+        let c = c.unwrap_or_else(|| panic!("{id}: {}", model.note));
+        assert!(c.significance < 10.0, "{id}: {c:?}");
+        assert_ne!(model.vote, Vote::Stiction, "{id}: {}", model.note);
+        assert_ne!(d.verdict, Verdict::Stiction, "{id}: {:?}", d.evidence);
+    }
 }

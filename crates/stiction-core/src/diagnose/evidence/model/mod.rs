@@ -22,8 +22,10 @@
 //! to 42, and at the same healthy percentile the test finds 37 % of the sticky routine loops
 //! instead of 32 %, and 61 % of the sticky fast loops instead of 48 %.)
 
+mod cycle;
 mod levels;
 
+pub use cycle::{CycleCancelled, CYCLE_CANCELLED_STICTION};
 pub use levels::{LevelsEvidence, LEVELS_STICTION, MAX_UNRECORDED};
 
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
@@ -135,6 +137,10 @@ pub struct ModelEvidence {
     /// The levels test, when the request is `thorough` and it ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub levels: Option<LevelsEvidence>,
+    /// The fits compared over whole periods of the cycle, when the loop limit-cycles and the
+    /// first comparison finds the fits alike ([`CycleCancelled`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle_cancelled: Option<CycleCancelled>,
 }
 
 /// The statistics of a comparison: shares of the compared output's variance above its noise.
@@ -176,7 +182,8 @@ impl EvidenceFamily for Model {
             "improvement of the fit with stiction over the linear loop, share of the PV's variance above its noise";
         let threshold = format!(
             "stiction when the improvement, held against the stiction fit's residual per independent change, reaches {SIGNIFICANCE_STICTION} \
-             (between the 95th and 97.5th percentiles of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more), or when OP explains under {:.0} % \
+             (between the 95th and 97.5th percentiles of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more: then the same test on \
+             changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}), or when OP explains under {:.0} % \
              of the PV's variation above its noise",
             100.0 * MIN_EXPLAINED
         );
@@ -212,6 +219,22 @@ impl EvidenceFamily for Model {
             evidence.kano_j
         );
         let (mut vote, mut strength, mut why) = vote(ctx, f, &levels);
+        if vote == Vote::Undetermined
+            && levels.significance <= SIGNIFICANCE_NONE
+            && limit_cycles(ctx)
+        {
+            // the fits look alike on a limit cycle: compare them over whole periods
+            evidence.cycle_cancelled = CycleCancelled::of(ctx, f);
+            if let Some(c) = &evidence.cycle_cancelled {
+                why = format!("{why}; {}", c.words());
+                if c.sticky() {
+                    let s = test_strength(
+                        c.significance / CYCLE_CANCELLED_STICTION * SIGNIFICANCE_STICTION,
+                    );
+                    (vote, strength) = (Vote::Stiction, s);
+                }
+            }
+        }
         if vote != Vote::Stiction && levels.explained >= MIN_EXPLAINED {
             if let Some(s) = test.stiction_strength() {
                 why = format!("the levels test finds a sticky valve where the fit of PV's changes does not ({why})");
@@ -278,7 +301,16 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
         sse_noise: f.samples_used as f64 * f.noise_var,
         calibration: CALIBRATION.into(),
         levels: None,
+        cycle_cancelled: None,
     }
+}
+
+/// The strength of a stiction vote at the test's ratio `significance` (at least the threshold):
+/// a half at the threshold, full at [`SIGNIFICANCE_DECISIVE`].
+fn test_strength(significance: f64) -> f64 {
+    (0.5 + 0.5 * (significance / SIGNIFICANCE_STICTION).ln()
+        / (SIGNIFICANCE_DECISIVE / SIGNIFICANCE_STICTION).ln())
+    .min(1.0)
 }
 
 /// The vote, its strength and why, from the fits' levels.
@@ -320,9 +352,7 @@ fn vote(ctx: &Context, f: &FitComparison, levels: &Levels) -> (Vote, f64, String
     } else if significance >= SIGNIFICANCE_STICTION {
         (
             Vote::Stiction,
-            (0.5 + 0.5 * (significance / SIGNIFICANCE_STICTION).ln()
-                / (SIGNIFICANCE_DECISIVE / SIGNIFICANCE_STICTION).ln())
-            .min(1.0),
+            test_strength(significance),
             format!(
                 "a sticky valve explains {:.1} % more of the PV's variation above its noise than a valve that follows OP, far beyond what a free band gains on healthy loops (test ratio {significance:.0})",
                 100.0 * improvement
