@@ -465,16 +465,8 @@ fn bad_input_is_one_clear_sentence() {
 /// A Stenman band of 2 (or a healthy valve) in the default loop, 2,000 samples, the setpoint
 /// stepping every 150 s: no hold has two of the sticky loop's cycles (about 105 s).
 fn short_holds(dir: &Path, d: &str) -> String {
-    let p = dir.join(format!("holds_{d}.csv"));
-    let param = format!("d={d}");
     let sp = "steps:amplitude=1,hold=150,offset=50,seed=1";
-    let path = p.to_str().unwrap();
-    ok(&[
-        "simulate",
-        "--loop",
-        "closed",
-        "--param",
-        &param,
+    let extra = [
         "--noise",
         "0.05",
         "--seed",
@@ -483,10 +475,21 @@ fn short_holds(dir: &Path, d: &str) -> String {
         sp,
         "--samples",
         "2000",
-        "-o",
-        path,
-    ]);
-    path.to_string()
+    ];
+    closed_loop(dir, &format!("holds_{d}.csv"), d, &extra)
+}
+
+/// `stiction simulate --loop closed --param d=D EXTRA -o DIR/NAME`, the file's path.
+fn closed_loop(dir: &Path, name: &str, d: &str, extra: &[&str]) -> String {
+    let path = dir.join(name).to_str().unwrap().to_string();
+    let param = format!("d={d}");
+    let args = [
+        &["simulate", "--loop", "closed", "--param", &param],
+        extra,
+        &["-o", &path],
+    ];
+    ok(&args.concat());
+    path
 }
 
 #[test]
@@ -522,22 +525,8 @@ fn a_cycle_across_short_setpoint_holds_is_judged_across_them_and_said() {
 /// Issue 10's integrating loop, typed as the issue types it: `simulate --loop closed --param d=D
 /// --process integrating:K=0.05,delay=5 --noise 0.05`.
 fn integrating_loop(dir: &Path, d: &str) -> String {
-    let p = dir.join(format!("integrating_{d}.csv"));
-    let path = p.to_str().unwrap();
-    ok(&[
-        "simulate",
-        "--loop",
-        "closed",
-        "--param",
-        &format!("d={d}"),
-        "--process",
-        "integrating:K=0.05,delay=5",
-        "--noise",
-        "0.05",
-        "-o",
-        path,
-    ]);
-    path.to_string()
+    let extra = ["--process", "integrating:K=0.05,delay=5", "--noise", "0.05"];
+    closed_loop(dir, &format!("integrating_{d}.csv"), d, &extra)
 }
 
 #[test]
