@@ -56,6 +56,7 @@ pub(super) fn simulate_n<const NA: usize, const NB: usize>(
     mut out: Option<&mut Vec<f64>>,
     bound: f64,
 ) -> f64 {
+    debug_assert!(NA <= 2, "orders are at most 2");
     let n = y.len();
     // the last two simulated outputs (y[k-1], y[k-2]; a missing order's is never read)
     let mut y1 = if NA > 0 { y[t0 - 1] } else { 0.0 };

@@ -8,9 +8,10 @@ use super::{MAX_LAG_SHARE, MIN_LAG};
 /// with it the stiction that drives it (issue 10's integrating loop: its 203 s cycle compared over
 /// 200 s, the fit with stiction did worse than the linear loop). A lag that keeps less than [`MIN_CYCLE_GAIN`] of a
 /// regular cycle of the PV moves to the nearest odd multiple of half its period (the longer
-/// within `max_lag`, else the shorter), where the difference keeps all of it.
+/// within `max_lag`, else the shorter), where the difference keeps all of it. `pv` is the PV
+/// with its trend removed ([`detrended`]).
 pub(super) fn off_the_cycle(lag: usize, pv: &[f64], max_lag: usize) -> usize {
-    let reg = crate::detect::regularity(&detrended(pv), 1.0);
+    let reg = crate::detect::regularity(pv, 1.0);
     let Some(period) = reg.period.filter(|_| reg.oscillating) else {
         return lag;
     };
@@ -35,7 +36,7 @@ pub(super) fn off_the_cycle(lag: usize, pv: &[f64], max_lag: usize) -> usize {
 const MIN_CYCLE_GAIN: f64 = 0.5;
 
 /// The PV with its straight-line trend removed.
-fn detrended(pv: &[f64]) -> Vec<f64> {
+pub(super) fn detrended(pv: &[f64]) -> Vec<f64> {
     let n = pv.len();
     let (tm, ym) = ((n as f64 - 1.0) / 2.0, pv.iter().sum::<f64>() / n as f64);
     let (mut stt, mut sty) = (0.0, 0.0);
@@ -50,10 +51,10 @@ fn detrended(pv: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// The first lag at which the autocorrelation of the PV (its straight-line trend removed) falls
-/// below one half: about the time the loop takes to forget where PV was.
+/// The first lag at which the autocorrelation of the PV (`pv`, its straight-line trend removed:
+/// [`detrended`]) falls below one half: about the time the loop takes to forget where PV was.
 pub(super) fn half_correlation(pv: &[f64]) -> usize {
-    let acf = crate::detect::autocorrelation(&detrended(pv), pv.len() / MAX_LAG_SHARE);
+    let acf = crate::detect::autocorrelation(pv, pv.len() / MAX_LAG_SHARE);
     acf.iter().position(|&r| r < 0.5).unwrap_or(acf.len())
 }
 
@@ -62,9 +63,10 @@ mod tests {
     use super::*;
 
     fn cycle(period: f64, n: usize) -> Vec<f64> {
-        (0..n)
+        let pv: Vec<f64> = (0..n)
             .map(|t| (2.0 * std::f64::consts::PI * t as f64 / period).sin() + 0.001 * t as f64)
-            .collect()
+            .collect();
+        detrended(&pv)
     }
 
     #[test]

@@ -27,7 +27,7 @@ use crate::detect::measurement_noise;
 use crate::identify::{self, Data, Fit, SearchRange, Structure};
 use crate::models::{Kano, Model, Stenman};
 use band::{exact_band, valve_start};
-use lag::{half_correlation, off_the_cycle};
+use lag::{detrended, half_correlation, off_the_cycle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -255,8 +255,9 @@ impl Setup {
         let response = phys.time_constant.unwrap_or(0.0) + phys.dead_time;
         // (an oscillating sticky loop's linear fit on levels is poor: its response time is read
         // off the PV's autocorrelation too, whichever is longer)
-        let mut lag =
-            ((LAG_RESPONSES * response / req.ts).round() as usize).max(half_correlation(pv));
+        let trendless = detrended(pv);
+        let mut lag = ((LAG_RESPONSES * response / req.ts).round() as usize)
+            .max(half_correlation(&trendless));
         if first.integrating {
             // a level's change grows with the lag while its noise does not: a long lag
             lag = lag.max(n / INTEGRATING_LAG_SHARE);
@@ -264,7 +265,7 @@ impl Setup {
         let max_lag = (n / MAX_LAG_SHARE).max(MIN_LAG);
         let lag = match req.lag {
             Some(l) => l.clamp(MIN_LAG, max_lag),
-            None => off_the_cycle(lag.clamp(MIN_LAG, max_lag), pv, max_lag),
+            None => off_the_cycle(lag.clamp(MIN_LAG, max_lag), &trendless, max_lag),
         };
         if n < lag + t0 + 20 * (search.na.len() + search.nb_max + 1) {
             return None;

@@ -228,6 +228,7 @@ impl EvidenceFamily for Model {
             if let Some(c) = &evidence.cycle_cancelled {
                 why = format!("{why}; {}", c.words());
                 if c.sticky() {
+                    // its ratio on the first test's scale: half strength at its own threshold
                     let s = test_strength(
                         c.significance / CYCLE_CANCELLED_STICTION * SIGNIFICANCE_STICTION,
                     );
