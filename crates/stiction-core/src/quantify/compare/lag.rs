@@ -5,11 +5,11 @@ use super::{MAX_LAG_SHARE, MIN_LAG};
 
 /// A lag whose difference keeps the PV's cycle: a change over a whole number of periods
 /// cancels a cycle (`x[t + L] - x[t]` scales a cycle of `P` samples by `2 |sin(π L / P)|`), and
-/// with it the stiction that drives it (issue 10's integrating loop: its 203 s cycle compared over
-/// 200 s, the fit with stiction did worse than the linear loop). A lag that keeps less than [`MIN_CYCLE_GAIN`] of a
-/// regular cycle of the PV moves to the nearest odd multiple of half its period (the longer
-/// within `max_lag`, else the shorter), where the difference keeps all of it. `pv` is the PV
-/// with its trend removed ([`detrended`]).
+/// with it the stiction that drives it (issue 10's integrating loop: its 203 s cycle compared
+/// over 200 s, the fit with stiction did worse than the linear loop). A lag that keeps less than
+/// [`MIN_CYCLE_GAIN`] of a regular cycle of the PV moves to the nearest odd multiple of half its
+/// period (the longer within `max_lag`, else the shorter), where the difference keeps all of it.
+/// `pv` is the PV with its trend removed ([`detrended`]).
 pub(super) fn off_the_cycle(lag: usize, pv: &[f64], max_lag: usize) -> usize {
     let reg = crate::detect::regularity(pv, 1.0);
     let Some(period) = reg.period.filter(|_| reg.oscillating) else {

@@ -19,12 +19,12 @@
 //! oscillating routine loop reaches 70, but OP explains only 29 % of what is left).
 
 use super::{Levels, MIN_EXPLAINED, SIGNIFICANCE_STICTION};
-
-/// The test's ratio at and above which the comparison over whole periods votes stiction.
-pub const CYCLE_CANCELLED_STICTION: f64 = 2.0 * SIGNIFICANCE_STICTION;
 use crate::diagnose::evidence::Context;
 use crate::quantify::{compare_fits, CompareRequest, FitComparison};
 use serde::{Deserialize, Serialize};
+
+/// The test's ratio at and above which the comparison over whole periods votes stiction.
+pub const CYCLE_CANCELLED_STICTION: f64 = 2.0 * SIGNIFICANCE_STICTION;
 
 /// The fits compared over whole periods of the cycle.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
