@@ -180,18 +180,27 @@ pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitC
             tried.push(s);
         }
     }
-    let linear_fit = optimum(&data, &setup.linear_mv, &tried);
+    // (the optima are independent: found side by side, compared in order)
+    let (linear_fit, band_fits) = rayon::join(
+        || optimum(&data, &setup.linear_mv, &tried),
+        || {
+            bands
+                .par_iter()
+                .map(|&(d, s)| {
+                    let m = Stenman::new(d).map(Model::Stenman).ok()?;
+                    optimum(&data, &problem.valve(&m), &neighbours(s)).map(|f| (m, f))
+                })
+                .collect::<Vec<_>>()
+        },
+    );
     evaluations += tried.len() as u64;
-    let (best_model, fit_stenman) = bands
-        .iter()
-        .filter_map(|&(d, s)| {
-            let m = Stenman::new(d).map(Model::Stenman).ok()?;
-            optimum(&data, &problem.valve(&m), &neighbours(s)).map(|f| (m, f))
-        })
-        .fold(None, |best: Option<(Model, Fit)>, (m, f)| match best {
+    let (best_model, fit_stenman) = band_fits.into_iter().flatten().fold(
+        None,
+        |best: Option<(Model, Fit)>, (m, f)| match best {
             Some(b) if b.1.sse_simulation <= f.sse_simulation => Some(b),
             _ => Some((m, f)),
-        })?;
+        },
+    )?;
     let best = (best_model, fit_stenman.sse_simulation);
     let (slip, fit_slip) = slip_jump(&problem, &best, &fit_stenman, op_range, &mut evaluations);
     let (stiction_model, fit_s) = if slip.1 < best.1 {
@@ -339,8 +348,12 @@ fn optimum(data: &Data, mv: &[f64], among: &[Structure]) -> Option<Fit> {
         .collect();
     fits.sort_by(|x, y| x.sse_simulation.total_cmp(&y.sse_simulation));
     fits.truncate(REFINED_STRUCTURES);
-    fits.iter()
+    let refined: Vec<Fit> = fits
+        .par_iter()
         .map(|f| identify::refine_output_error(data, mv, f, OE_ITERATIONS))
+        .collect();
+    refined
+        .into_iter()
         .min_by(|x, y| x.sse_simulation.total_cmp(&y.sse_simulation))
         .and_then(|f| identify::polish_output_error(data, mv, &f))
 }
