@@ -283,11 +283,7 @@ fn an_oscillation_that_op_does_not_drive_is_not_stiction() {
     };
     let d = diagnose(&rec, &DiagnoseRequest::default()).unwrap();
     assert_ne!(d.verdict, Verdict::Stiction, "{:#?}", d.evidence);
-    let model = d
-        .families
-        .iter()
-        .find(|f| f.family == Family::Model)
-        .unwrap();
+    let model = model_family(&d);
     assert_eq!(model.vote, Vote::NoStiction, "{model:#?}");
     assert!(
         model.note.contains("enters the loop elsewhere"),
@@ -299,6 +295,16 @@ fn an_oscillation_that_op_does_not_drive_is_not_stiction() {
 
 /// A catalogue loop judged as `plant_benchmark` judges it (its sampling time and process type,
 /// the defaults otherwise).
+/// The model family's evidence in a diagnosis.
+fn model_family(
+    d: &stiction_core::diagnose::Diagnosis,
+) -> &stiction_core::diagnose::evidence::FamilyEvidence {
+    d.families
+        .iter()
+        .find(|f| f.family == Family::Model)
+        .expect("every diagnosis has a model family")
+}
+
 pub(crate) fn judge_catalogue(id: &str) -> stiction_core::diagnose::Diagnosis {
     let l = stiction_core::sim::catalogue::find(id).unwrap();
     let req = DiagnoseRequest {
@@ -387,11 +393,7 @@ fn a_limit_cycle_whose_fits_look_alike_is_compared_over_whole_periods() {
     // with and without stiction look alike; over a whole period the cycle cancels, and the valve
     // explains what is left far better than OP
     let d = judge_catalogue("fast-c-0069");
-    let model = d
-        .families
-        .iter()
-        .find(|f| f.family == Family::Model)
-        .unwrap();
+    let model = model_family(&d);
     let c = model
         .model
         .as_ref()
@@ -407,11 +409,7 @@ fn a_limit_cycle_whose_fits_look_alike_is_compared_over_whole_periods() {
     // an external sinusoid (fast-c-0126) reach the same comparison, and the valve explains nothing
     for id in ["fast-c-0151", "fast-c-0126"] {
         let d = judge_catalogue(id);
-        let model = d
-            .families
-            .iter()
-            .find(|f| f.family == Family::Model)
-            .unwrap();
+        let model = model_family(&d);
         let c = model.model.as_ref().unwrap().cycle_cancelled.clone();
         let c = c.unwrap_or_else(|| panic!("{id}: {}", model.note));
         assert!(c.significance < 10.0, "{id}: {c:?}");
@@ -427,11 +425,7 @@ fn the_stiction_fit_is_also_polished_from_the_linear_loops_dynamics() {
     // stopped short of the linear loop's (R² 0.416 against 0.430); started from the linear loop's
     // dynamics it reaches 0.449, and the band's gain is beyond what healthy loops give
     let d = judge_catalogue("fast-c-0024");
-    let model = d
-        .families
-        .iter()
-        .find(|f| f.family == Family::Model)
-        .unwrap();
+    let model = model_family(&d);
     let m = model.model.as_ref().unwrap();
     assert!(
         m.r2_stenman.max(m.r2_slip_jump) >= m.r2_without_stiction,
