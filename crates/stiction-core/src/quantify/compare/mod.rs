@@ -21,14 +21,15 @@
 
 mod band;
 mod dependence;
+mod fits;
 mod lag;
 pub use dependence::correlation_span;
 
 use super::problem::{difference, range};
-use crate::detect::measurement_noise;
 use crate::identify::{self, Data, Fit, SearchRange, Structure};
 use crate::models::{Kano, Model, Stenman};
 use band::{exact_band, valve_start};
+use fits::Fits;
 use lag::{detrended, half_correlation, off_the_cycle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -393,98 +394,6 @@ fn slip_jump(
     (slip, fit_slip)
 }
 
-/// The compared fits, before they are put in words and R².
-struct Fits {
-    linear: Option<Fit>,
-    stenman: (Model, f64),
-    slip_jump: (Model, f64),
-    /// The better of the two stiction models, and its linear part.
-    stiction: Model,
-    stiction_fit: Fit,
-    x0: f64,
-    samples_used: usize,
-    evaluations: u64,
-}
-
-impl Fits {
-    fn into_comparison(
-        self,
-        op: &[f64],
-        pv: &[f64],
-        setup: &Setup,
-        req: &CompareRequest,
-    ) -> FitComparison {
-        let fit_s = self.stiction_fit;
-        let sst = fit_s.sst;
-        let phys = identify::physical(&fit_s, req.ts);
-        let levels = Data::new(pv, setup.t0);
-        let mv_stiction = self.stiction.simulate_from(op, Some(self.x0));
-        let mv_centred: Vec<f64> = mv_stiction.iter().map(|v| v - setup.offset).collect();
-        let pv_stiction = identify::simulate_pv(&levels, &mv_centred, &fit_s);
-        let pv_linear = self
-            .linear
-            .as_ref()
-            .map(|f| identify::simulate_pv(&levels, &setup.op_centred, f))
-            .unwrap_or_default();
-        let r2 = |sse: f64| 1.0 - sse / sst;
-        let linear_sse = self
-            .linear
-            .as_ref()
-            .map_or(sst, |f| f.sse_simulation.min(sst));
-        // the compared output's noise: white noise differenced over the lag (twice again for an
-        // integrating structure's change)
-        let sigma = measurement_noise(pv);
-        let compared = Data::new(&setup.y, setup.t0);
-        let mv_compared = {
-            let mut mv = vec![0.0; op.len() - setup.lag];
-            difference(&mv_stiction, setup.lag, &mut mv);
-            mv
-        };
-        let correlation_span = dependence::correlation_span(
-            &compared,
-            setup.lag,
-            (&mv_compared, &fit_s),
-            self.linear
-                .as_ref()
-                .map(|f| (setup.linear_mv.as_slice(), f)),
-        );
-        FitComparison {
-            correlation_span,
-            structure: fit_s.structure,
-            lag: setup.lag,
-            samples_used: self.samples_used,
-            sst,
-            noise_var: 2.0 * sigma * sigma,
-            valve_start: self.x0,
-            linear: ModelFit {
-                params: Vec::new(),
-                sse: linear_sse,
-                r2: r2(linear_sse),
-            },
-            stenman: ModelFit {
-                params: vec![self.stenman.0.values()[0]],
-                sse: self.stenman.1,
-                r2: r2(self.stenman.1),
-            },
-            slip_jump: ModelFit {
-                params: stiction_params(&self.slip_jump.0),
-                sse: self.slip_jump.1,
-                r2: r2(self.slip_jump.1),
-            },
-            gain: phys.gain,
-            time_constant: phys.time_constant,
-            dead_time: phys.dead_time,
-            evaluations: self.evaluations,
-            pv_linear,
-            pv_stiction,
-            mv_stiction,
-            linear_model: self.linear,
-            stiction_model: Some(fit_s),
-            op_offset: setup.offset,
-        }
-    }
-}
-
 /// A structure, then the same delay and family with the other orders: an equation-error fit of a
 /// disturbed loop can put a pole on or outside the unit circle, and its simulation runs away.
 fn neighbours(s: Structure) -> Vec<Structure> {
@@ -496,14 +405,6 @@ fn neighbours(s: Structure) -> Vec<Structure> {
         }
     }
     out
-}
-
-fn stiction_params(m: &Model) -> Vec<f64> {
-    match m {
-        // Stenman's valve as a slip-jump model: S = J = d
-        Model::Stenman(s) => vec![s.d, s.d],
-        other => other.values(),
-    }
 }
 
 /// The candidates' shared data.
