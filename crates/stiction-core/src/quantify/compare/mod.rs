@@ -209,28 +209,18 @@ pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitC
     } else {
         (best.0, fit_stenman)
     };
-    // the linear loop may do as well from the stiction fit's dynamics: a comparison of fits is
-    // fair only when neither optimisation stopped short
-    let linear_fit = match (
+    // a comparison of fits is fair only when neither optimisation stopped short
+    let (linear_fit, polished) = cross_polish(
+        &data,
+        (&setup.linear_mv, &problem.valve(&stiction_model)),
         linear_fit,
-        identify::polish_output_error(&data, &setup.linear_mv, &fit_s),
-    ) {
-        (Some(a), Some(b)) => Some(if b.sse_simulation < a.sse_simulation {
-            b
-        } else {
-            a
-        }),
-        (a, b) => a.or(b),
-    };
-    // ... and the stiction fit may do better from the linear loop's
+        &fit_s,
+    );
     let (mut best, mut slip, mut fit_s) = (best, slip, fit_s);
-    if let Some(f) = linear_fit
-        .as_ref()
-        .and_then(|l| identify::polish_output_error(&data, &problem.valve(&stiction_model), l))
-        .filter(|f| f.sse_simulation < fit_s.sse_simulation)
-    {
+    if let Some(f) = polished {
         let sse = f.sse_simulation;
         fit_s = f;
+        // the better stiction model's error (Kano's is never above Stenman's)
         if slip.1 < best.1 {
             slip.1 = sse;
         } else {
@@ -357,6 +347,30 @@ fn optimum(data: &Data, mv: &[f64], among: &[Structure]) -> Option<Fit> {
         .into_iter()
         .min_by(|x, y| x.sse_simulation.total_cmp(&y.sse_simulation))
         .and_then(|f| identify::polish_output_error(data, mv, &f))
+}
+
+/// Each fit polished again from the other's dynamics (a search from one start can stop short):
+/// the linear loop's fit (on `mv.0`, OP's changes), the better of it and its polish; and the
+/// stiction fit's polish (on `mv.1`, its valve's changes) when that is better than `stiction`.
+fn cross_polish(
+    data: &Data,
+    mv: (&[f64], &[f64]),
+    linear: Option<Fit>,
+    stiction: &Fit,
+) -> (Option<Fit>, Option<Fit>) {
+    let linear = match (linear, identify::polish_output_error(data, mv.0, stiction)) {
+        (Some(a), Some(b)) => Some(if b.sse_simulation < a.sse_simulation {
+            b
+        } else {
+            a
+        }),
+        (a, b) => a.or(b),
+    };
+    let polished = linear
+        .as_ref()
+        .and_then(|l| identify::polish_output_error(data, mv.1, l))
+        .filter(|f| f.sse_simulation < stiction.sse_simulation);
+    (linear, polished)
 }
 
 /// Kano's band S and slip jump J around the Stenman band `best` (J = S is close to Stenman's
