@@ -116,28 +116,48 @@ impl<'a> Prepared<'a> {
         changed: &[usize],
         rows: &mut Vec<usize>,
     ) {
-        let (s, y, t0, n) = (self.s, self.y, self.t0, self.y.len());
+        let (s, t0, n) = (self.s, self.t0, self.y.len());
         rows.clear();
+        // the rows that see a changed sample i through an input lag: i + nk and i + nk + 1;
+        // `changed` is increasing, so these come out increasing once repeats are skipped
         for &i in changed {
             for j in 0..s.nb {
                 let t = i + s.nk + j;
-                if t >= t0 && t < n {
+                if t >= t0 && t < n && rows.last().is_none_or(|&last| t > last) {
                     rows.push(t);
                 }
             }
         }
-        rows.sort_unstable();
-        rows.dedup();
-        for &t in rows.iter() {
+        match (s.na, s.nb) {
+            (0, 1) => self.update_rows_n::<0, 1>(sums, old, new, rows),
+            (0, 2) => self.update_rows_n::<0, 2>(sums, old, new, rows),
+            (1, 1) => self.update_rows_n::<1, 1>(sums, old, new, rows),
+            (1, 2) => self.update_rows_n::<1, 2>(sums, old, new, rows),
+            (2, 1) => self.update_rows_n::<2, 1>(sums, old, new, rows),
+            (2, 2) => self.update_rows_n::<2, 2>(sums, old, new, rows),
+            _ => unreachable!("orders are checked when prepared"),
+        }
+    }
+
+    /// The rows' share of the sums taken out for `old` and put in for `new`.
+    fn update_rows_n<const NA: usize, const NB: usize>(
+        &self,
+        sums: &mut ValveSums,
+        old: &[f64],
+        new: &[f64],
+        rows: &[usize],
+    ) {
+        let (nk, y) = (self.s.nk, self.y);
+        for &t in rows {
             for (mv, sign) in [(old, -1.0), (new, 1.0)] {
-                let m = [mv[t - s.nk], if s.nb > 1 { mv[t - s.nk - 1] } else { 0.0 }];
-                for j in 0..s.nb {
+                let m: [f64; NB] = std::array::from_fn(|j| mv[t - nk - j]);
+                for j in 0..NB {
                     sums.m1[j] += sign * m[j];
                     sums.hm[j] += sign * y[t] * m[j];
-                    for k in j..s.nb {
+                    for k in j..NB {
                         sums.mm[j][k] += sign * m[j] * m[k];
                     }
-                    for i in 0..s.na {
+                    for i in 0..NA {
                         sums.ym[i][j] += sign * y[t - 1 - i] * m[j];
                     }
                 }

@@ -82,6 +82,8 @@ fn chunks(lo: f64, hi: f64, only: Option<&[(f64, f64)]>) -> Vec<(f64, f64)> {
             let first = (hi - lo) * 1e-4;
             let mut edges: Vec<f64> = (0..CHUNKS)
                 .map(|i| lo + first * ((hi - lo) / first).powf(i as f64 / (CHUNKS - 1) as f64))
+                // the last edge can pass `hi` by a rounding
+                .map(|e| e.min(hi))
                 .collect();
             edges[0] = lo;
             edges.push(hi);
@@ -114,9 +116,8 @@ fn around_best(chunks: &[(f64, f64)], scan_costs: &[Vec<f64>]) -> Vec<(f64, f64)
 
 /// One thread's buffers for walking chunks of the d-partition.
 struct Walk {
-    /// The valve trajectory (the whole record)
-    full: Vec<f64>,
-    /// ... as the linear part sees it (differenced when the problems are), and the previous one.
+    /// The valve trajectory as the linear part sees it (less the offset, or differenced when the
+    /// problems are), and the previous cell's.
     mv: Vec<f64>,
     prev: Vec<f64>,
     changed: Vec<usize>,
@@ -127,7 +128,6 @@ impl Walk {
     /// `n`: samples the linear part sees.
     fn new(n: usize) -> Self {
         Self {
-            full: Vec::new(),
             mv: vec![0.0; n],
             prev: vec![0.0; n],
             changed: Vec::new(),
@@ -136,9 +136,9 @@ impl Walk {
     }
 
     /// Every cell of one chunk with its cost under each structure. Consecutive cells'
-    /// trajectories differ only on short stretches (they join again at the next slip both make),
-    /// so the walk keeps the least-squares sums of its previous cell and updates only the rows
-    /// that see a changed sample.
+    /// trajectories differ only on short stretches (they join again at the next slip both make):
+    /// the walk names the samples that changed, and the least-squares sums of the previous cell
+    /// are updated only on the rows that see them.
     fn chunk(
         &mut self,
         problems: &[Hammerstein],
@@ -147,7 +147,6 @@ impl Walk {
         start_bounds: &[f64],
     ) -> Vec<CellCosts> {
         let Walk {
-            full,
             mv: seen,
             prev,
             changed,
@@ -159,28 +158,27 @@ impl Walk {
         let mut bounds = start_bounds.to_vec();
         let mut sums: Vec<identify::ValveSums> = Vec::new();
         let x0 = problems[0].start.unwrap_or(problems[0].op[0]);
-        full.resize(problems[0].op.len(), 0.0);
-        exact::stenman_walk(problems[0].op, x0, chunk, range, full, |cell, full| {
-            let mv: &mut [f64] = if lag == 0 {
-                for v in full.iter_mut() {
-                    *v -= offset;
-                }
-                full
-            } else {
-                super::problem::difference(full, lag, seen);
-                seen
-            };
-            let refresh = sums.is_empty() || out.len() % FULL_EVERY == 0;
+        exact::stenman_walk_changes(problems[0].op, x0, chunk, range, |cell, full, moved| {
             changed.clear();
-            if !refresh {
-                changed_samples(mv, prev, changed);
+            match moved {
+                None => {
+                    if lag == 0 {
+                        for (s, &v) in seen.iter_mut().zip(full) {
+                            *s = v - offset;
+                        }
+                    } else {
+                        super::problem::difference(full, lag, seen);
+                    }
+                }
+                Some(moved) => seen_changes(full, moved, offset, lag, seen, prev, changed),
             }
+            let refresh = sums.is_empty() || out.len() % FULL_EVERY == 0;
             if !refresh && changed.len() < n / 8 {
                 for (p, s) in problems.iter().zip(sums.iter_mut()) {
-                    p.prepared.update_sums(s, prev, mv, changed, rows);
+                    p.prepared.update_sums(s, prev, seen, changed, rows);
                 }
             } else {
-                sums = problems.iter().map(|p| p.prepared.sums(mv)).collect();
+                sums = problems.iter().map(|p| p.prepared.sums(seen)).collect();
             }
             let costs: Vec<f64> = problems
                 .iter()
@@ -189,34 +187,61 @@ impl Walk {
                 .map(|((p, s), bound)| {
                     let c = p
                         .prepared
-                        .fit_from_sums(s, mv, *bound)
+                        .fit_from_sums(s, seen, *bound)
                         .map_or(f64::INFINITY, |f| f.sse_simulation);
                     *bound = bound.min(c);
                     c
                 })
                 .collect();
-            prev.copy_from_slice(mv);
+            if moved.is_none() {
+                prev.copy_from_slice(seen);
+            } else {
+                for &t in changed.iter() {
+                    prev[t] = seen[t];
+                }
+            }
             out.push((cell, costs));
         });
         out
     }
 }
 
-/// The samples where `mv` differs from `prev`, bit for bit, compared in blocks (most blocks are
-/// unchanged).
-fn changed_samples(mv: &[f64], prev: &[f64], changed: &mut Vec<usize>) {
-    for (blk, (m, p)) in mv.chunks(16).zip(prev.chunks(16)).enumerate() {
-        let differs = m
-            .iter()
-            .zip(p)
-            .fold(0u64, |acc, (x, y)| acc | (x.to_bits() ^ y.to_bits()));
-        if differs != 0 {
-            let base = blk * 16;
-            changed.extend(
-                (0..m.len())
-                    .filter(|&i| m[i].to_bits() != p[i].to_bits())
-                    .map(|i| base + i),
-            );
+/// The trajectory as the linear part sees it (`seen`), updated where the valve moved
+/// (`moved`, samples of the whole trajectory `full`), and the samples of `seen` that now differ
+/// from `prev` bit for bit, in increasing order.
+fn seen_changes(
+    full: &[f64],
+    moved: &[usize],
+    offset: f64,
+    lag: usize,
+    seen: &mut [f64],
+    prev: &[f64],
+    changed: &mut Vec<usize>,
+) {
+    let n = seen.len();
+    if lag == 0 {
+        for &i in moved {
+            seen[i] = full[i] - offset;
+            if seen[i].to_bits() != prev[i].to_bits() {
+                changed.push(i);
+            }
+        }
+        return;
+    }
+    // a moved sample i enters the changes over the lag that end at it (t = i - lag) and that
+    // start at it (t = i): two increasing sequences, merged
+    let ends = &moved[moved.partition_point(|&i| i < lag)..];
+    let starts = &moved[..moved.partition_point(|&i| i < n)];
+    let (mut e, mut s) = (0, 0);
+    while e < ends.len() || s < starts.len() {
+        let a = ends.get(e).map_or(usize::MAX, |&i| i - lag);
+        let b = starts.get(s).copied().unwrap_or(usize::MAX);
+        let t = a.min(b);
+        e += usize::from(a == t);
+        s += usize::from(b == t);
+        seen[t] = full[t + lag] - full[t];
+        if seen[t].to_bits() != prev[t].to_bits() {
+            changed.push(t);
         }
     }
 }

@@ -18,6 +18,9 @@ fn walk(n: usize, d: f64, noise: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
     (data.op, data.mv)
 }
 
+/// A visited cell of a walk: its edges, trajectory and the samples that changed.
+type WalkStep = ((f64, f64), Vec<f64>, Option<Vec<usize>>);
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
 
@@ -40,6 +43,45 @@ proptest! {
             prop_assert!(c >= sol.sse, "grid d = {} costs {} below the optimum {}", g, c, sol.sse);
             if !sol.contains(g) {
                 prop_assert!(c > sol.sse);
+            }
+        }
+    }
+
+    /// The walk that follows changes visits the same cells with the same trajectories as the
+    /// walk that simulates each cell whole, bit for bit, and names exactly the samples that
+    /// changed; also on OP quantised to a coarse step, where many steps tie at a cell's edge.
+    #[test]
+    fn incremental_walk_equals_the_whole_walk(seed in 0u64..1000, quantum in prop_oneof![Just(0.0), Just(0.1), Just(0.5)], start in -1.0f64..1.0, a in 0.0f64..1.0, width in 0.1f64..4.0) {
+        let (mut op, _) = walk(300, 0.5, 0.0, seed);
+        if quantum > 0.0 {
+            for u in op.iter_mut() {
+                *u = (*u / quantum).round() * quantum;
+            }
+        }
+        let x0 = op[0] + start;
+        let (lo, hi) = (0.0, 5.0);
+        let chunk = (a, (a + width).min(hi));
+        let mut whole: Vec<((f64, f64), Vec<f64>)> = Vec::new();
+        let mut mv = vec![0.0; op.len()];
+        exact::stenman_walk(&op, x0, chunk, (lo, hi), &mut mv, |cell, mv| whole.push((cell, mv.to_vec())));
+        let mut steps: Vec<WalkStep> = Vec::new();
+        exact::stenman_walk_changes(&op, x0, chunk, (lo, hi), |cell, mv, changed| {
+            steps.push((cell, mv.to_vec(), changed.map(|c| c.to_vec())))
+        });
+        prop_assert_eq!(whole.len(), steps.len());
+        for (k, ((c1, m1), (c2, m2, changed))) in whole.iter().zip(&steps).enumerate() {
+            prop_assert_eq!(c1.0.to_bits(), c2.0.to_bits(), "cell {} lower edge", k);
+            prop_assert_eq!(c1.1.to_bits(), c2.1.to_bits(), "cell {} upper edge", k);
+            let bits = |m: &[f64]| m.iter().map(|v| v.to_bits()).collect::<Vec<u64>>();
+            prop_assert_eq!(bits(m1), bits(m2), "cell {} trajectory", k);
+            match (k, changed) {
+                (0, None) => {}
+                (_, Some(changed)) if k > 0 => {
+                    let prev = &whole[k - 1].1;
+                    let truth: Vec<usize> = (0..m1.len()).filter(|&i| m1[i].to_bits() != prev[i].to_bits()).collect();
+                    prop_assert_eq!(&truth, changed, "cell {} changes", k);
+                }
+                _ => prop_assert!(false, "cell {}: changes given for the first cell or missing for a later one", k),
             }
         }
     }

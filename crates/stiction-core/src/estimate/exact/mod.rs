@@ -12,6 +12,10 @@
 //! A cell's cost is summed in the same order as [`super::objective`] sums a single d, so the two
 //! agree to the last bit and the bound can be compared exactly.
 
+mod walk;
+
+pub use walk::{stenman_cell_into, stenman_walk, stenman_walk_changes};
+
 use super::objective::Objective;
 use crate::models::ModelKind;
 use serde::{Deserialize, Serialize};
@@ -201,59 +205,5 @@ impl Cells {
         self.hi.append(&mut other.hi);
         self.x.append(&mut other.x);
         self.cost.append(&mut other.cost);
-    }
-}
-
-/// The cell of the Stenman partition that contains `d`: the range of d values whose valve
-/// trajectory driven by `op` from the valve position `x0` at the first sample is the same as d's,
-/// clipped to `[lo, hi)`. One pass over the data:
-/// the trajectory stays the same while every sticking step keeps `|u - x| <= d` and every slip
-/// keeps `|u - x| > d`. The trajectory itself is written to `mv`.
-// kept out of line: inlined into the walk, its loop variables were spilled to the stack
-#[inline(never)]
-pub fn stenman_cell_into(
-    op: &[f64],
-    x0: f64,
-    d: f64,
-    lo: f64,
-    hi: f64,
-    mv: &mut [f64],
-) -> (f64, f64) {
-    let (mut a, mut b) = (lo, hi);
-    let mut x = x0;
-    mv[0] = x;
-    for (&u, m) in op[1..].iter().zip(&mut mv[1..]) {
-        let delta = (u - x).abs();
-        let slips = delta > d;
-        // plain comparisons, not f64::min/max: the data are finite, and the NaN handling of
-        // min/max would sit on the loop-carried chains
-        b = if slips && delta < b { delta } else { b };
-        a = if !slips && delta > a { delta } else { a };
-        x = if slips { u } else { x };
-        *m = x;
-    }
-    (a, b)
-}
-
-/// Walk every cell of the Stenman partition of `[a, b)` (within the search range `[lo, hi)`) in
-/// order of d, handing each cell and its valve trajectory to `visit`. The valve stands at `x0` at
-/// the first sample.
-pub fn stenman_walk(
-    op: &[f64],
-    x0: f64,
-    (a, b): (f64, f64),
-    (lo, hi): (f64, f64),
-    mv: &mut [f64],
-    mut visit: impl FnMut((f64, f64), &mut [f64]),
-) {
-    let mut d = a;
-    while d < b {
-        let (ca, cb) = stenman_cell_into(op, x0, d, lo, hi, mv);
-        // the piece of the cell inside [a, b): cells that cross a chunk edge are visited in parts
-        visit((ca.max(a), cb.min(b)), mv);
-        if cb <= d {
-            break; // cannot happen for d in [lo, hi); guards against an endless loop
-        }
-        d = cb;
     }
 }
