@@ -32,16 +32,18 @@ pub(super) fn exact_stenman(
     let full = full || only.is_some();
     let mut chunks = chunks(lo, hi, only);
     let scan: Vec<f64> = chunks.iter().map(|c| 0.5 * (c.0 + c.1)).collect();
-    let scan_costs: Vec<Vec<f64>> = problems.iter().map(|p| p.costs_1d(&scan)).collect();
-    if !full {
-        chunks = around_best(&chunks, &scan_costs);
-    }
     // achievable costs to start from: simulations that exceed them stop early (such a cell can
     // never be optimal, so the optimal set is the same whatever the order of the work)
-    let start_bounds: Vec<f64> = scan_costs
-        .iter()
-        .map(|c| c.iter().copied().fold(f64::INFINITY, f64::min))
-        .collect();
+    let start_bounds: Vec<f64> = if full {
+        problems.iter().map(|p| p.min_cost_1d(&scan)).collect()
+    } else {
+        let scan_costs: Vec<Vec<f64>> = problems.iter().map(|p| p.costs_1d(&scan)).collect();
+        chunks = around_best(&chunks, &scan_costs);
+        scan_costs
+            .iter()
+            .map(|c| c.iter().copied().fold(f64::INFINITY, f64::min))
+            .collect()
+    };
     let n = problems[0].len();
     let per_chunk: Vec<Vec<CellCosts>> = chunks
         .par_iter()

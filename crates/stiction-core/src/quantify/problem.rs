@@ -116,6 +116,31 @@ impl<'a> Hammerstein<'a> {
     }
 }
 
+impl Hammerstein<'_> {
+    /// The least of the costs of many one-parameter candidates, as `costs_1d` would give it: in
+    /// fixed groups in parallel, each group's simulations stopped once they exceed the group's
+    /// best so far (the least cost is always simulated to its end, so it is the same).
+    pub(super) fn min_cost_1d(&self, values: &[f64]) -> f64 {
+        let n = self.len();
+        values
+            .par_chunks(8)
+            .map_init(
+                || vec![0.0; n],
+                |mv, group| {
+                    group.iter().fold(f64::INFINITY, |best, &v| {
+                        self.valve_into(&[v], mv);
+                        let cost = self
+                            .prepared
+                            .fit_bounded(mv, best)
+                            .map_or(f64::INFINITY, |f| f.sse_simulation);
+                        best.min(cost)
+                    })
+                },
+            )
+            .reduce(|| f64::INFINITY, f64::min)
+    }
+}
+
 impl CostFunction for Hammerstein<'_> {
     fn dim(&self) -> usize {
         self.kind.dim()

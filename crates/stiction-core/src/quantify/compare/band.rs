@@ -88,7 +88,7 @@ pub(super) fn valve_start(
         let ps = problems(op_m, &data, structures, lag, x0);
         let cost = ps
             .iter()
-            .map(|p| p.costs_1d(&grid).into_iter().fold(f64::INFINITY, f64::min))
+            .map(|p| p.min_cost_1d(&grid))
             .fold(f64::INFINITY, f64::min);
         walked += (grid.len() * ps.len()) as u64;
         if f == 0.0 {
