@@ -50,8 +50,29 @@ pub(super) fn mean(x: &[f64]) -> f64 {
     }
 }
 
+/// Plans each thread keeps at most.
+const MAX_PLANS: usize = 32;
+
+thread_local! {
+    /// Each thread's forward plans by size, each made by a fresh planner (a planner that made
+    /// other sizes can share their parts and round differently), so a diagnosis's many transforms
+    /// of one size are planned once and every result is the same whatever ran before it.
+    static PLANS: std::cell::RefCell<std::collections::HashMap<usize, Arc<dyn Fft<f64>>>> =
+        std::cell::RefCell::new(std::collections::HashMap::new());
+}
+
 pub(super) fn forward(n: usize) -> Arc<dyn Fft<f64>> {
-    FftPlanner::new().plan_fft_forward(n)
+    PLANS.with(|plans| {
+        let mut plans = plans.borrow_mut();
+        // a batch of records of many lengths would keep plans without end: start again
+        if plans.len() >= MAX_PLANS && !plans.contains_key(&n) {
+            plans.clear();
+        }
+        plans
+            .entry(n)
+            .or_insert_with(|| FftPlanner::new().plan_fft_forward(n))
+            .clone()
+    })
 }
 
 /// Unnormalised inverse transform with the forward plan (`conj ∘ FFT ∘ conj`), so each call

@@ -99,6 +99,35 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The plans kept between transforms change no result: a thread that has transformed many other
+/// sizes (more than it keeps) gives the same spectrum and autocorrelation, bit for bit, as a
+/// fresh thread (a planner shared between sizes would round some sizes differently).
+#[test]
+fn kept_plans_change_no_result() {
+    let x: Vec<f64> = white(3000, 9).iter().map(|v| 1.0 + v).collect();
+    fn judge(x: &[f64]) -> Vec<Vec<f64>> {
+        let mut out: Vec<Vec<f64>> = [210, 330, 462, 1155]
+            .iter()
+            .map(|&m| welch_psd(x, m))
+            .collect();
+        out.push(autocorrelation(x, 700));
+        out
+    }
+    let fresh = std::thread::spawn({
+        let x = x.clone();
+        move || judge(&x)
+    })
+    .join()
+    .unwrap();
+    for n in (40..240).step_by(7) {
+        let _ = welch_psd(&white(4 * n, 1), n);
+        let _ = autocorrelation(&white(n, n as u64), n / 2);
+    }
+    let again = judge(&x);
+    let bits = |r: &[Vec<f64>]| -> Vec<u64> { r.iter().flatten().map(|v| v.to_bits()).collect() };
+    assert_eq!(bits(&fresh), bits(&again));
+}
+
 #[test]
 fn autocorrelation_equals_the_direct_sum() {
     for (n, lag, seed) in [(500, 60, 1), (333, 400, 2), (7, 3, 3), (2, 5, 4), (1, 0, 5)] {
