@@ -22,6 +22,44 @@ pub(super) fn inverse_filter(x: &[f64], a: &[f64]) -> Vec<f64> {
     out
 }
 
+/// The normal equations (upper triangle) of the rows `row_at` writes for each index of `rows`,
+/// with the targets it returns. With `p` a constant inside, the sums unroll; each element is
+/// summed in the same order whatever `p`.
+fn normal_equations(
+    p: usize,
+    rows: std::ops::Range<usize>,
+    row_at: impl Fn(usize, &mut [f64; MAX_P]) -> f64,
+) -> ([[f64; MAX_P]; MAX_P], [f64; MAX_P]) {
+    fn sums<const P: usize>(
+        rows: std::ops::Range<usize>,
+        row_at: impl Fn(usize, &mut [f64; MAX_P]) -> f64,
+    ) -> ([[f64; MAX_P]; MAX_P], [f64; MAX_P]) {
+        let mut g = [[0.0f64; MAX_P]; MAX_P];
+        let mut h = [0.0f64; MAX_P];
+        let mut row = [0.0f64; MAX_P];
+        for t in rows {
+            let target = row_at(t, &mut row);
+            for i in 0..P {
+                h[i] += row[i] * target;
+                for j in i..P {
+                    g[i][j] += row[i] * row[j];
+                }
+            }
+        }
+        (g, h)
+    }
+    match p {
+        1 => sums::<1>(rows, row_at),
+        2 => sums::<2>(rows, row_at),
+        3 => sums::<3>(rows, row_at),
+        4 => sums::<4>(rows, row_at),
+        5 => sums::<5>(rows, row_at),
+        6 => sums::<6>(rows, row_at),
+        7 => sums::<7>(rows, row_at),
+        _ => sums::<MAX_P>(rows, row_at),
+    }
+}
+
 /// Move a fit towards the output-error optimum (Steiglitz and McBride 1965): the output and the
 /// valve position are filtered by `1 / A(q)` of the current fit and the structure refitted by
 /// least squares, `iterations` times. An equation-error fit of noisy closed-loop data is biased,
@@ -42,10 +80,7 @@ pub fn refine_output_error(data: &Data, mv: &[f64], start: &Fit, iterations: usi
     for _ in 0..iterations {
         let yf = inverse_filter(y, &a);
         let mf = inverse_filter(mv, &a);
-        let mut g = [[0.0f64; MAX_P]; MAX_P];
-        let mut h = [0.0f64; MAX_P];
-        let mut row = [0.0f64; MAX_P];
-        for t in t0..n {
+        let (g, h) = normal_equations(p, t0..n, |t, row| {
             for i in 0..s.na {
                 row[i] = yf[t - 1 - i];
             }
@@ -53,13 +88,8 @@ pub fn refine_output_error(data: &Data, mv: &[f64], start: &Fit, iterations: usi
                 row[s.na + j] = mf[t - s.nk - j];
             }
             row[p - 1] = 1.0;
-            for i in 0..p {
-                h[i] += row[i] * yf[t];
-                for j in i..p {
-                    g[i][j] += row[i] * row[j];
-                }
-            }
-        }
+            yf[t]
+        });
         let Some(theta) = solve(&g, &h, p) else {
             break;
         };
@@ -161,21 +191,17 @@ pub(super) fn levenberg_marquardt(
             if !residuals(&t, &mut rk).is_finite() {
                 return best_of(start, y, mv, t0, &theta, sse);
             }
-            for i in 0..m {
-                jac[i * p + k] = (r[i] - rk[i]) / h;
+            // column by column (each column contiguous, so the divisions vectorise)
+            for (j, (a, b)) in jac[k * m..(k + 1) * m].iter_mut().zip(r.iter().zip(&rk)) {
+                *j = (a - b) / h;
             }
         }
-        let mut g = [[0.0f64; MAX_P]; MAX_P];
-        let mut h = [0.0f64; MAX_P];
-        for i in 0..m {
-            let row = &jac[i * p..(i + 1) * p];
-            for a in 0..p {
-                h[a] += row[a] * r[i];
-                for b in a..p {
-                    g[a][b] += row[a] * row[b];
-                }
+        let (g, h) = normal_equations(p, 0..m, |i, row| {
+            for (k, v) in row[..p].iter_mut().enumerate() {
+                *v = jac[k * m + i];
             }
-        }
+            r[i]
+        });
         let mut improved = false;
         for _ in 0..6 {
             let mut gl = g;
