@@ -74,18 +74,17 @@ pub fn stenman_walk_changes(
         return;
     }
     let mut walker = Walker::new(op, x0, a, (lo, hi));
-    let (mut ca, mut cb) = walker.edges();
+    let (ca, mut cb) = walker.edges();
     visit((ca.max(a), cb.min(b)), &walker.x, None);
     while cb < b {
         walker.advance(cb);
-        let (na, nb) = walker.edges();
-        if nb <= cb {
+        let (ca, next) = walker.edges();
+        if next <= cb {
             break; // cannot happen for d in [lo, hi); guards against an endless loop
         }
-        (ca, cb) = (na, nb);
+        cb = next;
         visit((ca.max(a), cb.min(b)), &walker.x, Some(&walker.changed));
     }
-    let _ = ca;
 }
 
 /// One walk's state: the trajectory, each step's `|u - x|` as a sticking or a slipping step
