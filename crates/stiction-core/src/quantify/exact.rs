@@ -297,3 +297,55 @@ fn outcome(
             .collect(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::seen_changes;
+
+    /// The trajectory as the linear part sees it, computed whole (levels less the offset, or
+    /// changes over the lag).
+    fn seen_whole(full: &[f64], offset: f64, lag: usize) -> Vec<f64> {
+        if lag == 0 {
+            full.iter().map(|v| v - offset).collect()
+        } else {
+            (0..full.len() - lag)
+                .map(|t| full[t + lag] - full[t])
+                .collect()
+        }
+    }
+
+    /// Updated where the valve moved, the seen trajectory equals the one computed whole, and the
+    /// changes named are exactly the samples that differ from before, in increasing order: moves
+    /// at the record's ends, runs of moves, and moves that cancel over the lag.
+    #[test]
+    fn seen_changes_follow_the_valves_moves() {
+        let n = 60;
+        let old: Vec<f64> = (0..n).map(|i| ((i * 7) % 11) as f64).collect();
+        // [10, 13] at lag 3: the change over the lag from 10 to 13 cancels
+        let moves: [&[usize]; 5] = [
+            &[0],
+            &[n - 1],
+            &[3, 4, 5, 6, 20, 21],
+            &[0, 1, 58, 59],
+            &[10, 13],
+        ];
+        for lag in [0, 1, 3, 12] {
+            for moved in moves {
+                let mut new = old.clone();
+                for &i in moved {
+                    new[i] += 1.5;
+                }
+                let prev = seen_whole(&old, 2.0, lag);
+                let mut seen = prev.clone();
+                let mut changed = Vec::new();
+                seen_changes(&new, moved, 2.0, lag, &mut seen, &prev, &mut changed);
+                let whole = seen_whole(&new, 2.0, lag);
+                assert_eq!(seen, whole, "lag {lag}, moved {moved:?}");
+                let truth: Vec<usize> = (0..whole.len())
+                    .filter(|&t| whole[t].to_bits() != prev[t].to_bits())
+                    .collect();
+                assert_eq!(changed, truth, "lag {lag}, moved {moved:?}");
+            }
+        }
+    }
+}
