@@ -163,15 +163,7 @@ impl Walk {
         exact::stenman_walk_changes(problems[0].op, x0, chunk, range, |cell, full, moved| {
             changed.clear();
             match moved {
-                None => {
-                    if lag == 0 {
-                        for (s, &v) in seen.iter_mut().zip(full) {
-                            *s = v - offset;
-                        }
-                    } else {
-                        super::problem::difference(full, lag, seen);
-                    }
-                }
+                None => seen_whole(full, offset, lag, seen),
                 Some(moved) => seen_changes(full, moved, offset, lag, seen, prev, changed),
             }
             let refresh = sums.is_empty() || out.len() % FULL_EVERY == 0;
@@ -205,6 +197,18 @@ impl Walk {
             out.push((cell, costs));
         });
         out
+    }
+}
+
+/// The trajectory as the linear part sees it (`seen`): the valve position less the offset, or
+/// its changes over the lag.
+fn seen_whole(full: &[f64], offset: f64, lag: usize, seen: &mut [f64]) {
+    if lag == 0 {
+        for (s, &v) in seen.iter_mut().zip(full) {
+            *s = v - offset;
+        }
+    } else {
+        super::problem::difference(full, lag, seen);
     }
 }
 
@@ -300,18 +304,12 @@ fn outcome(
 
 #[cfg(test)]
 mod tests {
-    use super::seen_changes;
+    use super::{seen_changes, seen_whole};
 
-    /// The trajectory as the linear part sees it, computed whole (levels less the offset, or
-    /// changes over the lag).
-    fn seen_whole(full: &[f64], offset: f64, lag: usize) -> Vec<f64> {
-        if lag == 0 {
-            full.iter().map(|v| v - offset).collect()
-        } else {
-            (0..full.len() - lag)
-                .map(|t| full[t + lag] - full[t])
-                .collect()
-        }
+    fn seen_of(full: &[f64], offset: f64, lag: usize) -> Vec<f64> {
+        let mut seen = vec![0.0; full.len() - lag];
+        seen_whole(full, offset, lag, &mut seen);
+        seen
     }
 
     /// Updated where the valve moved, the seen trajectory equals the one computed whole, and the
@@ -335,11 +333,11 @@ mod tests {
                 for &i in moved {
                     new[i] += 1.5;
                 }
-                let prev = seen_whole(&old, 2.0, lag);
+                let prev = seen_of(&old, 2.0, lag);
                 let mut seen = prev.clone();
                 let mut changed = Vec::new();
                 seen_changes(&new, moved, 2.0, lag, &mut seen, &prev, &mut changed);
-                let whole = seen_whole(&new, 2.0, lag);
+                let whole = seen_of(&new, 2.0, lag);
                 assert_eq!(seen, whole, "lag {lag}, moved {moved:?}");
                 let truth: Vec<usize> = (0..whole.len())
                     .filter(|&t| whole[t].to_bits() != prev[t].to_bits())
