@@ -114,9 +114,7 @@ impl<'a> Hammerstein<'a> {
             );
         out
     }
-}
 
-impl Hammerstein<'_> {
     /// The least of the costs of many one-parameter candidates, as `costs_1d` would give it: in
     /// fixed groups in parallel, each group's simulations stopped once they exceed the group's
     /// best so far (the least cost is always simulated to its end, so it is the same).

@@ -118,18 +118,29 @@ impl<'a> Walker<'a> {
             changed: Vec::new(),
         };
         let mut x = x0;
-        for (i, &u) in op.iter().enumerate().skip(1) {
-            let delta = (u - x).abs();
-            if delta > d {
-                x = u;
-                w.slip[i] = delta;
-            } else {
-                w.stick[i] = delta;
-            }
+        for i in 1..n {
+            x = w.step(i, x, d);
             w.x[i] = x;
         }
         w.refresh_blocks(0, blocks);
         w
+    }
+
+    /// Step `i` of band `d` from the valve position `x`: whether it sticks or slips (its
+    /// `|u - x|` kept as such), and where the valve stands after it.
+    #[inline]
+    fn step(&mut self, i: usize, x: f64, d: f64) -> f64 {
+        let u = self.op[i];
+        let delta = (u - x).abs();
+        if delta > d {
+            self.slip[i] = delta;
+            self.stick[i] = f64::NEG_INFINITY;
+            u
+        } else {
+            self.stick[i] = delta;
+            self.slip[i] = f64::INFINITY;
+            x
+        }
     }
 
     fn refresh_blocks(&mut self, from: usize, to: usize) {
@@ -175,22 +186,13 @@ impl<'a> Walker<'a> {
         let n = self.x.len();
         let start = (first_block * BLOCK..((first_block + 1) * BLOCK).min(n))
             .find(|&i| self.slip[i] == d)
-            .unwrap_or(first_block * BLOCK);
+            .expect("the block's smallest slip is one of its steps");
         // every tie lies before this step
         let ties_end = ((last_block + 1) * BLOCK).min(n);
         let mut x = self.x[start - 1];
         let mut end = n;
         for i in start..n {
-            let u = self.op[i];
-            let delta = (u - x).abs();
-            if delta > d {
-                x = u;
-                self.slip[i] = delta;
-                self.stick[i] = f64::NEG_INFINITY;
-            } else {
-                self.stick[i] = delta;
-                self.slip[i] = f64::INFINITY;
-            }
+            x = self.step(i, x, d);
             if x.to_bits() != self.x[i].to_bits() {
                 self.x[i] = x;
                 self.changed.push(i);
