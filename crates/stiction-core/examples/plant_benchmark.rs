@@ -25,6 +25,8 @@
 
 #[path = "common/catalogue_loop.rs"]
 mod catalogue_loop;
+#[path = "common/confidence_table.rs"]
+mod confidence_table;
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -496,6 +498,7 @@ fn run_suite(o: &Options, suite: Suite, md: &mut String, jsonl: &mut String) {
         );
     }
     sticky_table(md, &loops, &res);
+    confidence_table::confidence_table(md, &groups);
     if THOROUGH.load(std::sync::atomic::Ordering::Relaxed) {
         levels_table(md, &groups);
     }
