@@ -49,3 +49,19 @@ fn a_vote_outranks_a_lean() {
     ];
     assert_eq!(decide(&families, &calm()).verdict, Verdict::NoStiction);
 }
+
+#[test]
+fn weak_evidence_against_stiction_says_so_in_the_next_step() {
+    let weak = |strength: f64| {
+        let mut f = family(Family::StickSlip, Vote::NoStiction, None);
+        f.strength = strength;
+        f
+    };
+    let d = decide(&[weak(0.25)], &calm());
+    assert_eq!(d.verdict, Verdict::NoStiction);
+    assert!(d.next_step.contains("weak"), "{}", d.next_step);
+    assert!(d.next_step.contains("valve travel test"), "{}", d.next_step);
+    let d = decide(&[weak(0.9)], &calm());
+    assert_eq!(d.verdict, Verdict::NoStiction);
+    assert_eq!(d.next_step, "no action on the valve");
+}
