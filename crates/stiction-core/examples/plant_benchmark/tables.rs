@@ -1,0 +1,322 @@
+//! The plant benchmark's tables: verdicts, goals, index votes, reasons and sticky loops by band,
+//! per class of the catalogue.
+
+use super::VERDICTS;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use stiction_core::diagnose::{Diagnosis, Verdict, Vote};
+use stiction_core::sim::catalogue::{BenchmarkLoop, LoopClass, NoiseLevel, Suite, Truth};
+
+fn pct(n: usize, of: usize) -> String {
+    if of == 0 {
+        "-".into()
+    } else {
+        format!("{:.0} %", 100.0 * n as f64 / of as f64)
+    }
+}
+
+fn count(ds: &[&Diagnosis], v: Verdict) -> usize {
+    ds.iter().filter(|d| d.verdict == v).count()
+}
+
+/// Results grouped by class, in the catalogue's class order.
+pub(super) fn by_class<'a>(
+    loops: &'a [BenchmarkLoop],
+    res: &'a [(Diagnosis, f64)],
+) -> BTreeMap<LoopClass, Vec<(&'a BenchmarkLoop, &'a Diagnosis)>> {
+    let mut m: BTreeMap<LoopClass, Vec<_>> = BTreeMap::new();
+    for (l, (d, _)) in loops.iter().zip(res) {
+        m.entry(l.class).or_default().push((l, d));
+    }
+    m
+}
+
+/// With `--thorough`: the levels test's ratio per class (loops where it ran).
+pub(super) fn levels_table(
+    md: &mut String,
+    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
+) {
+    let _ = writeln!(
+        md,
+        "The levels test's ratio (loops where it ran; it votes stiction from {:.0}):\n",
+        stiction_core::diagnose::evidence::model::LEVELS_STICTION
+    );
+    let _ = writeln!(
+        md,
+        "| class | tested | median | 95th percentile | at or above the threshold |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|");
+    for (class, of) in groups {
+        let mut r: Vec<f64> = of
+            .iter()
+            .filter_map(|(_, d)| {
+                d.families
+                    .iter()
+                    .find_map(|f| f.model.as_ref().and_then(|m| m.levels.as_ref()))
+                    .map(|l| l.ratio)
+            })
+            .collect();
+        r.sort_by(f64::total_cmp);
+        let at = |q: f64| {
+            r.get(((r.len() as f64 - 1.0) * q).round() as usize)
+                .copied()
+                .unwrap_or(f64::NAN)
+        };
+        let above = r
+            .iter()
+            .filter(|&&x| x >= stiction_core::diagnose::evidence::model::LEVELS_STICTION)
+            .count();
+        let _ = writeln!(
+            md,
+            "| {class} | {} of {} | {:.1} | {:.1} | {above} |",
+            r.len(),
+            of.len(),
+            at(0.5),
+            at(0.95)
+        );
+    }
+    let _ = writeln!(md);
+}
+
+pub(super) fn verdict_table(
+    md: &mut String,
+    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
+) {
+    let _ = writeln!(
+        md,
+        "| class | truth | loops | stiction | no_stiction | undetermined | insufficient_data | right | mean confidence | slips (median) |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    for (class, items) in groups {
+        let ds: Vec<&Diagnosis> = items.iter().map(|i| i.1).collect();
+        let n = ds.len();
+        let c = VERDICTS.map(|v| count(&ds, v));
+        let right = match class.truth() {
+            Truth::Sticky => pct(c[0], n),
+            Truth::NotSticky => pct(c[1], n),
+            Truth::BacklashOnly => "(outside the goals)".into(),
+        };
+        // the mean confidence of the decided verdicts
+        let decided: Vec<f64> = ds.iter().filter_map(|d| d.confidence).collect();
+        let conf = decided.iter().sum::<f64>() / decided.len().max(1) as f64;
+        let mut slips: Vec<usize> = items.iter().map(|i| i.0.slips).collect();
+        slips.sort_unstable();
+        let _ = writeln!(
+            md,
+            "| {class} | {} | {n} | {} | {} | {} | {} | {right} | {conf:.2} | {} |",
+            class.truth().name(),
+            c[0],
+            c[1],
+            c[2],
+            c[3],
+            slips[slips.len() / 2]
+        );
+    }
+    let _ = writeln!(md);
+}
+
+fn goal(md: &mut String, what: &str, value: String, target: &str, met: bool) {
+    let _ = writeln!(
+        md,
+        "| {what} | {value} | {target} | {} |",
+        if met { "met" } else { "missed" }
+    );
+}
+
+pub(super) fn goals(
+    md: &mut String,
+    suite: Suite,
+    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
+) {
+    let of = |t: Truth| -> Vec<&Diagnosis> {
+        groups
+            .iter()
+            .filter(|(c, _)| c.truth() == t)
+            .flat_map(|(_, v)| v.iter().map(|i| i.1))
+            .collect()
+    };
+    let (sticky, healthy) = (of(Truth::Sticky), of(Truth::NotSticky));
+    let _ = writeln!(md, "| goal | value | target | |\n|---|---|---|---|");
+    let share = |n: usize, of: usize| n as f64 / of.max(1) as f64;
+    let look_alike_target = if suite == Suite::Routine { 0.90 } else { 0.95 };
+    if sticky.is_empty() || healthy.is_empty() && suite == Suite::Routine {
+        // one side only (--only): no balanced accuracy or sticky share to compute
+    } else if suite == Suite::Routine {
+        let tpr = share(count(&sticky, Verdict::Stiction), sticky.len());
+        let tnr = share(count(&healthy, Verdict::NoStiction), healthy.len());
+        let ba = (tpr + tnr) / 2.0;
+        goal(
+            md,
+            "balanced accuracy (sticky called stiction, not-sticky called no_stiction)",
+            format!("{ba:.3} ({tpr:.3} / {tnr:.3})"),
+            ">= 0.95",
+            ba >= 0.95,
+        );
+    } else {
+        let tpr = share(count(&sticky, Verdict::Stiction), sticky.len());
+        goal(
+            md,
+            "sticky loops called stiction",
+            format!("{:.1} %", 100.0 * tpr),
+            ">= 95 %",
+            tpr >= 0.95,
+        );
+    }
+    for (class, items) in groups.iter().filter(|(c, _)| c.truth() == Truth::NotSticky) {
+        let ds: Vec<&Diagnosis> = items.iter().map(|i| i.1).collect();
+        let not = share(ds.len() - count(&ds, Verdict::Stiction), ds.len());
+        goal(
+            md,
+            &format!("{class}: not called stiction"),
+            format!("{:.1} %", 100.0 * not),
+            &format!(">= {:.0} %", 100.0 * look_alike_target),
+            not >= look_alike_target,
+        );
+    }
+    if suite == Suite::Routine {
+        let all: Vec<&Diagnosis> = sticky.iter().chain(&healthy).copied().collect();
+        let undecided = share(
+            count(&all, Verdict::Undetermined) + count(&all, Verdict::InsufficientData),
+            all.len(),
+        );
+        goal(
+            md,
+            "undetermined + insufficient_data (backlash left out)",
+            format!("{:.1} %", 100.0 * undecided),
+            "<= 10 %",
+            undecided <= 0.10,
+        );
+    }
+    let _ = writeln!(md);
+}
+
+/// Per class, how often each index voted stiction (S) and no stiction (N); index names as the
+/// diagnoses report them.
+pub(super) fn vote_table(
+    md: &mut String,
+    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
+) {
+    let mut names: Vec<String> = Vec::new();
+    for d in groups.values().flatten().map(|i| i.1) {
+        for ix in &d.indices {
+            if !names.contains(&ix.name) {
+                names.push(ix.name.clone());
+            }
+        }
+    }
+    if names.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "Index votes per class (share of the class's loops voting S stiction / N no stiction):\n"
+    );
+    let _ = writeln!(md, "| class | {} |", names.join(" | "));
+    let _ = writeln!(md, "|---|{}", "---|".repeat(names.len()));
+    for (class, items) in groups {
+        let n = items.len();
+        let cells: Vec<String> = names
+            .iter()
+            .map(|name| {
+                let votes = |v: Vote| {
+                    items
+                        .iter()
+                        .filter(|i| i.1.indices.iter().any(|x| &x.name == name && x.vote == v))
+                        .count()
+                };
+                format!(
+                    "S {} / N {}",
+                    pct(votes(Vote::Stiction), n),
+                    pct(votes(Vote::NoStiction), n)
+                )
+            })
+            .collect();
+        let _ = writeln!(md, "| {class} | {} |", cells.join(" | "));
+    }
+    let _ = writeln!(md);
+}
+
+/// A reason with every number (digits, a decimal point, a sign) shown as one `#`.
+fn blank_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        let starts = c.is_ascii_digit()
+            || (c == '-' || c == '.') && chars.peek().is_some_and(|n| n.is_ascii_digit());
+        if starts {
+            while chars
+                .peek()
+                .is_some_and(|n| n.is_ascii_digit() || *n == '.' || *n == 'e')
+            {
+                chars.next();
+            }
+            out.push('#');
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// The most frequent reasons given per class (numbers blanked so alike reasons group).
+pub(super) fn reason_table(
+    md: &mut String,
+    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
+) {
+    let _ = writeln!(
+        md,
+        "Most frequent reasons (for verdicts that give one; numbers shown as #):\n"
+    );
+    let _ = writeln!(md, "| class | reason | loops |\n|---|---|---|");
+    for (class, items) in groups {
+        let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+        for (_, d) in items {
+            if let Some(r) = &d.reason {
+                let key = blank_numbers(r);
+                *counts.entry(key).or_default() += 1;
+            }
+        }
+        let mut top: Vec<(String, usize)> = counts.into_iter().collect();
+        top.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        for (reason, n) in top.into_iter().take(2) {
+            let _ = writeln!(md, "| {class} | {} | {n} |", reason.replace('|', "/"));
+        }
+    }
+    let _ = writeln!(md);
+}
+
+/// Sticky loops called stiction, by band size and noise level.
+pub(super) fn sticky_table(md: &mut String, loops: &[BenchmarkLoop], res: &[(Diagnosis, f64)]) {
+    let bins = [
+        (0.0, 1.0, "0.5-1 %"),
+        (1.0, 2.0, "1-2 %"),
+        (2.0, 99.0, "2-5 %"),
+    ];
+    let _ = writeln!(
+        md,
+        "Sticky loops called stiction, by band (Stenman d, Kano S, He fs) and PV noise:\n"
+    );
+    let _ = writeln!(
+        md,
+        "| band | low noise | medium noise | high noise |\n|---|---|---|---|"
+    );
+    for (lo, hi, label) in bins {
+        let cells: Vec<String> = NoiseLevel::ALL
+            .iter()
+            .map(|&nl| {
+                let sel: Vec<&Diagnosis> = loops
+                    .iter()
+                    .zip(res)
+                    .filter(|(l, _)| {
+                        let band = l.setup.model.values()[0];
+                        l.truth == Truth::Sticky && l.noise_level == nl && band >= lo && band < hi
+                    })
+                    .map(|(_, r)| &r.0)
+                    .collect();
+                format!("{} of {}", count(&sel, Verdict::Stiction), sel.len())
+            })
+            .collect();
+        let _ = writeln!(md, "| {label} | {} |", cells.join(" | "));
+    }
+    let _ = writeln!(md);
+}
