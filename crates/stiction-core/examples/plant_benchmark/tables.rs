@@ -7,6 +7,9 @@ use std::fmt::Write as _;
 use stiction_core::diagnose::{Diagnosis, Verdict, Vote};
 use stiction_core::sim::catalogue::{BenchmarkLoop, LoopClass, NoiseLevel, Suite, Truth};
 
+/// The results by class, in the catalogue's class order.
+pub(super) type Groups<'a> = BTreeMap<LoopClass, Vec<(&'a BenchmarkLoop, &'a Diagnosis)>>;
+
 fn pct(n: usize, of: usize) -> String {
     if of == 0 {
         "-".into()
@@ -20,10 +23,7 @@ fn count(ds: &[&Diagnosis], v: Verdict) -> usize {
 }
 
 /// Results grouped by class, in the catalogue's class order.
-pub(super) fn by_class<'a>(
-    loops: &'a [BenchmarkLoop],
-    res: &'a [(Diagnosis, f64)],
-) -> BTreeMap<LoopClass, Vec<(&'a BenchmarkLoop, &'a Diagnosis)>> {
+pub(super) fn by_class<'a>(loops: &'a [BenchmarkLoop], res: &'a [(Diagnosis, f64)]) -> Groups<'a> {
     let mut m: BTreeMap<LoopClass, Vec<_>> = BTreeMap::new();
     for (l, (d, _)) in loops.iter().zip(res) {
         m.entry(l.class).or_default().push((l, d));
@@ -32,10 +32,7 @@ pub(super) fn by_class<'a>(
 }
 
 /// With `--thorough`: the levels test's ratio per class (loops where it ran).
-pub(super) fn levels_table(
-    md: &mut String,
-    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
-) {
+pub(super) fn levels_table(md: &mut String, groups: &Groups) {
     let _ = writeln!(
         md,
         "The levels test's ratio (loops where it ran; it votes stiction from {:.0}):\n",
@@ -78,10 +75,7 @@ pub(super) fn levels_table(
     let _ = writeln!(md);
 }
 
-pub(super) fn verdict_table(
-    md: &mut String,
-    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
-) {
+pub(super) fn verdict_table(md: &mut String, groups: &Groups) {
     let _ = writeln!(
         md,
         "| class | truth | loops | stiction | no_stiction | undetermined | insufficient_data | right | mean confidence | slips (median) |"
@@ -123,11 +117,7 @@ fn goal(md: &mut String, what: &str, value: String, target: &str, met: bool) {
     );
 }
 
-pub(super) fn goals(
-    md: &mut String,
-    suite: Suite,
-    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
-) {
+pub(super) fn goals(md: &mut String, suite: Suite, groups: &Groups) {
     let of = |t: Truth| -> Vec<&Diagnosis> {
         groups
             .iter()
@@ -192,10 +182,7 @@ pub(super) fn goals(
 
 /// Per class, how often each index voted stiction (S) and no stiction (N); index names as the
 /// diagnoses report them.
-pub(super) fn vote_table(
-    md: &mut String,
-    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
-) {
+pub(super) fn vote_table(md: &mut String, groups: &Groups) {
     let mut names: Vec<String> = Vec::new();
     for d in groups.values().flatten().map(|i| i.1) {
         for ix in &d.indices {
@@ -259,10 +246,7 @@ fn blank_numbers(text: &str) -> String {
 }
 
 /// The most frequent reasons given per class (numbers blanked so alike reasons group).
-pub(super) fn reason_table(
-    md: &mut String,
-    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
-) {
+pub(super) fn reason_table(md: &mut String, groups: &Groups) {
     let _ = writeln!(
         md,
         "Most frequent reasons (for verdicts that give one; numbers shown as #):\n"
