@@ -25,8 +25,7 @@
 
 #[path = "../common/catalogue_loop.rs"]
 mod catalogue_loop;
-#[path = "../common/confidence_table.rs"]
-mod confidence_table;
+mod confidence;
 mod tables;
 use tables::{
     by_class, goals, levels_table, reason_table, sticky_table, verdict_table, vote_table,
@@ -199,7 +198,7 @@ fn run_suite(o: &Options, suite: Suite, md: &mut String, jsonl: &mut String) {
         );
     }
     sticky_table(md, &loops, &res);
-    confidence_table::confidence_table(md, &groups);
+    confidence::confidence_table(md, &groups);
     if THOROUGH.load(std::sync::atomic::Ordering::Relaxed) {
         levels_table(md, &groups);
     }

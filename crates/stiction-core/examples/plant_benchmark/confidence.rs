@@ -2,10 +2,10 @@
 //! means on the benchmark's mix of loops (not a probability on a plant's own mix, where sticky
 //! valves may be rarer or commoner).
 
-use std::collections::BTreeMap;
+use super::tables::Groups;
 use std::fmt::Write as _;
-use stiction_core::diagnose::{Diagnosis, Verdict};
-use stiction_core::sim::catalogue::{BenchmarkLoop, LoopClass, Truth};
+use stiction_core::diagnose::Verdict;
+use stiction_core::sim::catalogue::Truth;
 
 /// The confidence bands' lower edges.
 const BANDS: [f64; 4] = [0.0, 0.4, 0.6, 0.8];
@@ -17,10 +17,7 @@ fn band(c: f64) -> usize {
 
 /// The table: for `stiction` and `no_stiction`, per confidence band, the verdicts given and the
 /// share right (backlash-only valves left out: they are outside the goals).
-pub fn confidence_table(
-    md: &mut String,
-    groups: &BTreeMap<LoopClass, Vec<(&BenchmarkLoop, &Diagnosis)>>,
-) {
+pub(super) fn confidence_table(md: &mut String, groups: &Groups) {
     // [verdict][band] = (given, right)
     let mut cells = [[(0usize, 0usize); BANDS.len()]; 2];
     for (class, items) in groups {
