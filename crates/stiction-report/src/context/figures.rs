@@ -1,51 +1,7 @@
-//! The loop report's context: every value the template shows, built from the loop's data and
-//! its diagnosis as plain serialisable structs (text, numbers already in words, figures as SVG).
-//! The template lays it out and escapes every text; nothing here writes HTML but the charts.
+//! The report's figures: the trends (an overview and a zoom on long records) and the PV-OP phase
+//! plot, decimated so spikes and the envelope survive.
 
-use super::plots::{self, Figure, PHASE_SIZE, TREND_SIZE};
-use super::sections::{self, Estimates, Evidence, KvRow, Notes, Quality, Windows};
-use super::series::{self, LONG_RECORD};
-use super::PageOptions;
-use crate::words::{capital, duration, num, verdict};
-use crate::{ColumnNames, LoopData};
-use anyhow::Result;
-use serde::Serialize;
-use stiction_core::diagnose::Diagnosis;
-use stiction_core::quantify::{Quantification, QuantifyStatus};
-
-/// Text with a little markup: plain runs, `code` runs and `strong` runs.
-#[derive(Serialize, Default)]
-pub struct Rich(Vec<Piece>);
-
-#[derive(Serialize)]
-struct Piece {
-    kind: &'static str,
-    text: String,
-}
-
-impl Rich {
-    fn push(mut self, kind: &'static str, text: impl Into<String>) -> Rich {
-        self.0.push(Piece {
-            kind,
-            text: text.into(),
-        });
-        self
-    }
-    pub fn text(self, t: impl Into<String>) -> Rich {
-        self.push("text", t)
-    }
-    pub fn code(self, t: impl Into<String>) -> Rich {
-        self.push("code", t)
-    }
-    pub fn strong(self, t: impl Into<String>) -> Rich {
-        self.push("strong", t)
-    }
-}
-
-/// Plain text as [`Rich`].
-pub fn rich(t: impl Into<String>) -> Rich {
-    Rich::default().text(t)
-}
+use super::*;
 
 /// Trends: the record (an overview when it is long), the figures and a note on the stretch.
 #[derive(Serialize)]
@@ -63,56 +19,6 @@ pub struct Zoom {
     pub figures: Vec<Figure>,
 }
 
-#[derive(Serialize)]
-pub struct VerdictBox {
-    pub code: &'static str,
-    pub word: String,
-    pub confidence: Option<String>,
-    pub bar_percent: Option<f64>,
-    pub reason: Option<String>,
-    pub evidence: Vec<String>,
-    pub band: Option<BandLine>,
-    pub next_step: String,
-}
-
-#[derive(Serialize)]
-pub struct BandLine {
-    pub percent: String,
-    pub set: Option<String>,
-    pub source: &'static str,
-}
-
-#[derive(Serialize)]
-pub struct Link {
-    pub href: String,
-    pub text: String,
-}
-
-/// Everything the report template shows.
-#[derive(Serialize)]
-pub struct Report {
-    pub version: &'static str,
-    pub title: String,
-    pub loop_id: String,
-    pub verdict_words: &'static str,
-    pub back: Option<Link>,
-    pub meta: String,
-    pub columns: Vec<Rich>,
-    pub toc: Vec<Link>,
-    pub verdict: VerdictBox,
-    pub trends: Trends,
-    pub zoom: Option<Zoom>,
-    pub phase: Figure,
-    pub evidence: Evidence,
-    pub oscillation: Option<Vec<KvRow>>,
-    pub estimates: Estimates,
-    pub convergence: Option<sections::Convergence>,
-    pub quality: Quality,
-    pub windows: Option<Windows>,
-    pub notes: Notes,
-    pub seconds: String,
-}
-
 /// Trends keep the first, lowest and highest sample of this many buckets (spikes and envelope
 /// survive); a long record's overview fewer; the phase plot keeps every k-th sample up to this
 /// many points.
@@ -121,133 +27,6 @@ const OVERVIEW_BUCKETS: usize = 600;
 const PHASE_POINTS: usize = 6000;
 /// Buckets enough to keep every sample of a zoom window (at most 2000).
 const EVERY_SAMPLE: usize = 1 << 20;
-
-pub fn build(loop_id: &str, data: &LoopData, d: &Diagnosis, o: &PageOptions) -> Result<Report> {
-    let q = d
-        .quantification
-        .as_ref()
-        .filter(|q| q.status == QuantifyStatus::Ok);
-    let zoom = if data.op.len() > LONG_RECORD {
-        Some(zoom(data, d, q)?)
-    } else {
-        None
-    };
-    Ok(Report {
-        version: env!("CARGO_PKG_VERSION"),
-        title: format!("{loop_id}: {}", verdict(d.verdict)),
-        loop_id: loop_id.to_string(),
-        verdict_words: verdict(d.verdict),
-        back: o.back_link.as_ref().map(|(href, text)| Link {
-            href: href.clone(),
-            text: text.clone(),
-        }),
-        meta: meta(data, d),
-        columns: o.columns.map(|c| columns(c, data)).unwrap_or_default(),
-        toc: toc(d, zoom.is_some()),
-        verdict: verdict_box(d),
-        trends: trends(data, d, q)?,
-        zoom,
-        phase: phase(data, d, q)?,
-        evidence: sections::evidence(d),
-        oscillation: sections::oscillation(d),
-        estimates: sections::estimates(d, q),
-        convergence: q.map(sections::convergence),
-        quality: sections::quality(d),
-        windows: sections::windows(d),
-        notes: sections::notes(d, q, o.reading),
-        seconds: num(d.seconds),
-    })
-}
-
-fn meta(data: &LoopData, d: &Diagnosis) -> String {
-    let [s, e] = d.analysed;
-    format!(
-        "{} samples at {} s, {} in all; analysed samples {s} to {e}{}{}.",
-        d.samples,
-        num(d.ts),
-        duration(d.samples as f64 * d.ts),
-        if data.auto.is_some() {
-            ", in automatic"
-        } else {
-            ""
-        },
-        if data.sp.is_some() {
-            " with a constant setpoint"
-        } else {
-            ""
-        },
-    )
-}
-
-fn columns(c: &ColumnNames, data: &LoopData) -> Vec<Rich> {
-    let mut parts = vec![rich("OP ").code(&c.op), rich("PV ").code(&c.pv)];
-    if let Some(sp) = &c.sp {
-        parts.push(rich("SP ").code(sp));
-    }
-    if let Some(m) = &c.mode {
-        parts.push(rich("mode ").code(m));
-    }
-    match (&c.time, &data.time) {
-        (Some(t), _) => parts.push(rich("time ").code(t)),
-        (None, Some(_)) => parts.push(rich("time column found by its name")),
-        (None, None) => {}
-    }
-    if c.integrating {
-        parts.push(rich("integrating process"));
-    }
-    parts
-}
-
-fn toc(d: &Diagnosis, zoom: bool) -> Vec<Link> {
-    let mut links = vec![("trends", "Trends")];
-    if zoom {
-        links.push(("zoom", "Zoom"));
-    }
-    links.extend([
-        ("phase", "PV against OP"),
-        ("indices", "Indices"),
-        ("oscillation", "Oscillation"),
-        ("estimates", "Estimates"),
-        ("convergence", "Convergence"),
-        ("quality", "Data quality"),
-    ]);
-    if !d.windows.is_empty() {
-        links.push(("windows", "Windows"));
-    }
-    links.push(("notes", "Notes"));
-    links
-        .into_iter()
-        .map(|(id, text)| Link {
-            href: format!("#{id}"),
-            text: text.into(),
-        })
-        .collect()
-}
-
-fn verdict_box(d: &Diagnosis) -> VerdictBox {
-    // for insufficient data and a loop without oscillation the evidence repeats the reason
-    let repeats_reason = matches!((d.evidence.as_slice(), &d.reason), ([e], Some(r)) if e == r);
-    VerdictBox {
-        code: d.verdict.as_str(),
-        word: capital(verdict(d.verdict)),
-        confidence: d.confidence.map(|c| format!("{c:.2}")),
-        bar_percent: d.confidence.map(|c| (c.clamp(0.0, 1.0) * 100.0).round()),
-        reason: d.reason.clone(),
-        evidence: if repeats_reason {
-            vec![]
-        } else {
-            d.evidence.clone()
-        },
-        band: d.band.as_ref().map(|b| BandLine {
-            percent: num(b.band_percent_of_span),
-            set: b
-                .interval_percent_of_span
-                .map(|[lo, hi]| format!("optimal set {} to {} %", num(lo), num(hi))),
-            source: b.source.words(),
-        }),
-        next_step: d.next_step.clone(),
-    }
-}
 
 /// The PV chart (with SP and the simulated PV) and the OP chart (with the estimated valve) over
 /// the samples `[a, b)`, `buckets` decimation buckets each.
@@ -320,7 +99,7 @@ fn trend_pair(
     Ok(vec![pv_fig, op_fig])
 }
 
-fn trends(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Trends> {
+pub(super) fn trends(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Trends> {
     let n = data.op.len();
     let overview = n > LONG_RECORD;
     let buckets = if overview {
@@ -357,7 +136,7 @@ fn trends(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<
 
 /// The window of a long record where OP and PV vary most, inside the analysed stretch, at full
 /// resolution.
-fn zoom(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Zoom> {
+pub(super) fn zoom(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Zoom> {
     let n = data.op.len();
     let [s, e] = d.analysed;
     let (s, e) = if s < e && e <= n { (s, e) } else { (0, n) };
@@ -393,7 +172,7 @@ fn zoom(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Zo
     })
 }
 
-fn phase(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Figure> {
+pub(super) fn phase(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Figure> {
     let [s, e] = d.quantified.unwrap_or(d.analysed);
     let (s, e) = if s + 1 < e && e <= data.op.len() {
         (s, e)
