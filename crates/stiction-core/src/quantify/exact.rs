@@ -252,6 +252,26 @@ fn seen_changes(
     }
 }
 
+/// Ranges of d in increasing order of their starts, with those that touch or overlap joined.
+pub(super) fn merge_sorted(ranges: impl IntoIterator<Item = (f64, f64)>) -> Vec<(f64, f64)> {
+    let mut merged: Vec<(f64, f64)> = Vec::new();
+    for r in ranges {
+        match merged.last_mut() {
+            Some(last) if last.1 >= r.0 => last.1 = last.1.max(r.1),
+            _ => merged.push(r),
+        }
+    }
+    merged
+}
+
+/// The cells of least cost of several outcomes (a staged search's first stage), as ranges of d
+/// in increasing order, joined where they touch or overlap.
+pub(super) fn merged_top_cells<'a>(outcomes: impl Iterator<Item = &'a Outcome>) -> Vec<(f64, f64)> {
+    let mut ranges: Vec<(f64, f64)> = outcomes.flat_map(|o| o.top_cells.iter().copied()).collect();
+    ranges.sort_by(|a, b| a.0.total_cmp(&b.0));
+    merge_sorted(ranges)
+}
+
 /// The optimal set of structure `s` over the walked cells.
 fn outcome(
     cells: &[CellCosts],
@@ -264,16 +284,13 @@ fn outcome(
     // sums updated step by step round differently from fresh ones: a hair of tolerance
     // keeps the pieces of one trajectory together
     let tolerance = 1e-9 * best.abs();
-    let mut optimal: Vec<(f64, f64)> = Vec::new();
-    for (cell, costs) in cells {
-        if costs[s] <= best + tolerance {
-            match optimal.last_mut() {
-                // pieces of one cell split at a chunk edge join again
-                Some(last) if last.1 >= cell.0 => last.1 = last.1.max(cell.1),
-                _ => optimal.push(*cell),
-            }
-        }
-    }
+    // (pieces of one cell split at a chunk edge join again)
+    let optimal = merge_sorted(
+        cells
+            .iter()
+            .filter(|c| c.1[s] <= best + tolerance)
+            .map(|c| c.0),
+    );
     // the widest optimal piece's midpoint is the point estimate; the interval their hull
     let (a, b) = optimal
         .iter()

@@ -2,7 +2,7 @@
 
 use crate::identify::{Data, Structure};
 use crate::models::ModelKind;
-use crate::quantify::exact::exact_stenman;
+use crate::quantify::exact::{exact_stenman, merged_top_cells};
 use crate::quantify::problem::Hammerstein;
 
 /// A staged walk starts on this many samples, or this many oscillation periods of the PV if
@@ -129,18 +129,7 @@ pub(super) fn exact_band(
         let staged = problems(&op[..m], &first, structures, lag, x0);
         let stage = exact_stenman(&staged, (0.0, op_range), true, None);
         walked += stage.iter().map(|o| o.evaluations).max().unwrap_or(0);
-        let mut ranges: Vec<(f64, f64)> = stage
-            .iter()
-            .flat_map(|o| o.top_cells.iter().copied())
-            .collect();
-        ranges.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut merged: Vec<(f64, f64)> = Vec::new();
-        for r in ranges {
-            match merged.last_mut() {
-                Some(last) if last.1 >= r.0 => last.1 = last.1.max(r.1),
-                _ => merged.push(r),
-            }
-        }
+        let merged = merged_top_cells(stage.iter());
         exact_stenman(&whole, (0.0, op_range), true, Some(&merged))
     } else {
         exact_stenman(&whole, (0.0, op_range), true, None)

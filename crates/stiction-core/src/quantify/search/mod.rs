@@ -2,7 +2,7 @@
 //! record be quantified at all), the pilot structures (which linear models to try), the search of
 //! the stiction parameters per structure, and the result.
 
-use super::exact::exact_stenman;
+use super::exact::{exact_stenman, merged_top_cells};
 use super::heuristic::{axis_intervals, grid_search, polish};
 use super::pilots::{first_guesses, pilot_points, MOST_STRUCTURES, STARTING_STRUCTURES};
 use super::problem::{range, Hammerstein};

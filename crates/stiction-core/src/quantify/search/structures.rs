@@ -199,21 +199,8 @@ pub(super) fn search_round(
 
 /// For a staged search: the structures best first, and the best cells of the two best, merged.
 pub(super) fn hint_for_whole_record(tried: &[Tried]) -> Hint {
-    let mut ranges: Vec<(f64, f64)> = tried
-        .iter()
-        .take(2)
-        .flat_map(|t| t.outcome.top_cells.iter().copied())
-        .collect();
-    ranges.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut merged: Vec<(f64, f64)> = Vec::new();
-    for r in ranges {
-        match merged.last_mut() {
-            Some(last) if last.1 >= r.0 => last.1 = last.1.max(r.1),
-            _ => merged.push(r),
-        }
-    }
     Hint {
         structures: tried.iter().map(|t| t.structure).collect(),
-        ranges: merged,
+        ranges: merged_top_cells(tried.iter().take(2).map(|t| &t.outcome)),
     }
 }
