@@ -2,7 +2,7 @@
 //! means on the benchmark's mix of loops (not a probability on a plant's own mix, where sticky
 //! valves may be rarer or commoner).
 
-use super::tables::Groups;
+use super::tables::{pct, Groups};
 use std::fmt::Write as _;
 use stiction_core::diagnose::Verdict;
 use stiction_core::sim::catalogue::Truth;
@@ -58,10 +58,7 @@ pub(super) fn confidence_table(md: &mut String, groups: &Groups) {
                 if given == 0 {
                     "-".into()
                 } else {
-                    format!(
-                        "{right} of {given} ({:.0} %)",
-                        100.0 * right as f64 / given as f64
-                    )
+                    format!("{right} of {given} ({})", pct(right, given))
                 }
             })
             .collect();

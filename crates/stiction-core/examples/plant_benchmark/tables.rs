@@ -10,7 +10,7 @@ use stiction_core::sim::catalogue::{BenchmarkLoop, LoopClass, NoiseLevel, Suite,
 /// The results by class, in the catalogue's class order.
 pub(super) type Groups<'a> = BTreeMap<LoopClass, Vec<(&'a BenchmarkLoop, &'a Diagnosis)>>;
 
-fn pct(n: usize, of: usize) -> String {
+pub(super) fn pct(n: usize, of: usize) -> String {
     if of == 0 {
         "-".into()
     } else {
