@@ -3,13 +3,14 @@
 //! the goals of both issues computed.
 //!
 //!     cargo run --release -p stiction-core --example plant_benchmark -- [--set routine|fast|all]
-//!         [--calibration] [--thorough] [--only CLASS] [--out docs/plant-benchmark.md] [--jsonl FILE] [--threads N]
+//!         [--calibration | --extra N] [--thorough] [--only CLASS] [--out docs/plant-benchmark.md] [--jsonl FILE] [--threads N]
 //!
 //! Every loop is judged as `stiction diagnose loop.csv --sp sp` judges it: the setpoint and the
 //! time column given, `integrating` from the loop, the default request otherwise (the closed-loop
 //! check of a stiction verdict on). Loops run in parallel (rayon); the results keep catalogue
 //! order and do not depend on the thread count. `--calibration` uses the calibration seeds (for
-//! setting thresholds); without it, the benchmark seeds. `--only` keeps one class (its name as in
+//! setting thresholds); `--extra N` a further calibration draw (more loops of each class to check
+//! a threshold on, `sim::catalogue::Set::Extra`); without either, the benchmark seeds. `--only` keeps one class (its name as in
 //! the tables). `--jsonl` writes one line per loop: id, class, truth, parameters, slip count and the
 //! whole `Diagnosis`.
 //!
@@ -26,6 +27,7 @@
 #[path = "../common/catalogue_loop.rs"]
 mod catalogue_loop;
 mod confidence;
+mod spread;
 mod tables;
 use tables::{
     by_class, goals, levels_table, reason_table, sticky_table, verdict_table, vote_table,
@@ -58,6 +60,8 @@ struct Options {
     out: Option<String>,
     jsonl: Option<String>,
     threads: Option<usize>,
+    /// `--spread N`: the goals on the calibration set and N further draws, beside the benchmark.
+    spread: Option<u8>,
 }
 
 fn fail(msg: &str) -> ! {
@@ -74,6 +78,7 @@ fn options() -> Options {
         out: None,
         jsonl: None,
         threads: None,
+        spread: None,
     };
     let mut i = 0;
     let value = |i: usize, flag: &str| -> String {
@@ -115,13 +120,27 @@ fn options() -> Options {
                 i += 1;
                 continue;
             }
+            "--spread" => {
+                o.spread = Some(
+                    value(i, flag)
+                        .parse()
+                        .unwrap_or_else(|_| fail("--spread needs a number of draws from 0 to 255")),
+                )
+            }
+            "--extra" => {
+                o.set = Set::Extra(
+                    value(i, flag)
+                        .parse()
+                        .unwrap_or_else(|_| fail("--extra needs a draw number from 0 to 255")),
+                )
+            }
             "--thorough" => {
                 THOROUGH.store(true, std::sync::atomic::Ordering::Relaxed);
                 i += 1;
                 continue;
             }
             other => fail(&format!(
-                "unknown argument '{other}'; the flags are --set, --calibration, --thorough, --only, --out, --jsonl, --threads"
+                "unknown argument '{other}'; the flags are --set, --calibration, --extra, --spread, --thorough, --only, --out, --jsonl, --threads"
             )),
         }
         i += 2;
@@ -242,12 +261,22 @@ fn main() {
         .num_threads(o.threads.unwrap_or(0))
         .build()
         .unwrap_or_else(|e| fail(&format!("cannot start the threads: {e}")));
+    if let Some(n) = o.spread {
+        let md = pool.install(|| spread::spread(&o, n));
+        println!("{md}");
+        if let Some(out) = &o.out {
+            std::fs::write(out, &md).unwrap_or_else(|e| fail(&format!("{out}: cannot write: {e}")));
+            eprintln!("wrote {out}");
+        }
+        return;
+    }
     let mut md = String::new();
     let mut jsonl = String::new();
     let thorough = THOROUGH.load(std::sync::atomic::Ordering::Relaxed);
     let set = match o.set {
-        Set::Benchmark => "benchmark",
-        Set::Calibration => "calibration",
+        Set::Benchmark => "benchmark".to_string(),
+        Set::Calibration => "calibration".to_string(),
+        Set::Extra(n) => format!("extra calibration draw {n}"),
     };
     let _ = writeln!(
         md,
@@ -259,7 +288,11 @@ fn main() {
          Right: a sticky loop called `stiction`, a not-sticky one called `no_stiction`.\n",
         if thorough { "--thorough " } else { "" },
         if thorough { "-thorough" } else { "" },
-        if o.set == Set::Calibration { " with `--calibration`" } else { "" },
+        match o.set {
+            Set::Benchmark => String::new(),
+            Set::Calibration => " with `--calibration`".to_string(),
+            Set::Extra(n) => format!(" with `--extra {n}`"),
+        },
         if thorough {
             "Every loop is judged with `--thorough`: the model family also runs the levels test (every distinct Stenman \
              valve scored on PV's levels, AR noise model; `stiction_core::identify::levels`). Beside \

@@ -3,8 +3,8 @@
 
 use stiction_core::models::{Kano, Model};
 use stiction_core::sim::catalogue::{
-    self, catalogue, find, issue14_example, BenchmarkLoop, LoopClass, NoiseLevel, Set, Suite,
-    Truth, MIN_SLIPS,
+    self, catalogue, find, generate, issue14_example, loop_id, BenchmarkLoop, LoopClass,
+    NoiseLevel, Set, Suite, Truth, MIN_SLIPS,
 };
 use stiction_core::sim::Characteristic;
 
@@ -177,6 +177,32 @@ fn benchmark_and_calibration_sets_differ_but_share_the_plan() {
     for (x, y) in b.iter().zip(&c) {
         assert_eq!(x.class, y.class);
         assert_ne!(x.data.pv, y.data.pv, "{} and {}", x.id, y.id);
+    }
+}
+
+#[test]
+fn extra_draws_are_other_loops_of_the_same_plan_found_by_id() {
+    for i in [0, 300, 479] {
+        let c = generate(Suite::Routine, Set::Calibration, i).unwrap();
+        let x1 = generate(Suite::Routine, Set::Extra(1), i).unwrap();
+        let x2 = generate(Suite::Routine, Set::Extra(2), i).unwrap();
+        assert_eq!((x1.class, x2.class), (c.class, c.class));
+        assert_ne!(x1.data.pv, c.data.pv, "{}", x1.id);
+        assert_ne!(x1.data.pv, x2.data.pv, "{}", x1.id);
+        let found = find(&x2.id).unwrap();
+        assert_eq!(
+            (found.id.as_str(), &found.data.pv),
+            (x2.id.as_str(), &x2.data.pv)
+        );
+    }
+    assert_eq!(loop_id(Suite::Fast, Set::Extra(7), 12), "fast-x7-0012");
+    for bad in [
+        "routine-x-0001",
+        "routine-xa-0001",
+        "routine-x256-0001",
+        "routine-y1-0001",
+    ] {
+        assert!(find(bad).is_none(), "{bad}");
     }
 }
 
