@@ -3,6 +3,7 @@
 //! (`Set::Extra`), each alone and pooled, beside the benchmark set: a threshold is chosen on the
 //! calibration draws, the benchmark only checks it.
 
+use super::confidence::confidence_table;
 use super::tables::{by_class, goal_rows, GoalRow};
 use super::{judge, suite_title, Options};
 use rayon::prelude::*;
@@ -88,6 +89,8 @@ fn spread_table(o: &Options, suite: Suite, extra: u8, md: &mut String) {
         );
     }
     let _ = writeln!(md);
+    let _ = writeln!(md, "Pooled over the calibration draws:\n");
+    confidence_table(md, &by_class(&pooled_loops, &pooled_res));
 }
 
 /// The page: every suite asked for, on `extra` further draws.
