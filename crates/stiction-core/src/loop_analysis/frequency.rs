@@ -169,6 +169,8 @@ mod tests {
             kc,
             ki: kc / ti,
             ti: Some(ti),
+            kc_continuous: kc + kc / ti / 2.0,
+            ti_continuous: Some(ti + 0.5),
             action: Action::Reverse,
             lag: 0,
             r2: 1.0,

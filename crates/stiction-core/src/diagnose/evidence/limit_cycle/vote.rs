@@ -215,7 +215,7 @@ fn facts(e: &LoopEvidence) -> String {
     );
     format!(
         "cycle of {:.0} s, OP amplitude {:.2}; the loop needs a valve gain {:.2} and lag {:.0}°{}; {harmonics_text}; \
-         {:.0} % of the PV's cycle unexplained by OP; {}; gain margin {}; PI Kc {:.3}, Ti {} (R² {:.2})",
+         {:.0} % of the PV's cycle unexplained by OP; {}; gain margin {}; PI Kc {:.3}, Ti {} for a controller much faster than the samples, Kc {:.3}, Ti {} for one that runs once a sample (R² {:.2})",
         e.period,
         e.op_amplitude,
         e.needed_gain,
@@ -232,8 +232,19 @@ fn facts(e: &LoopEvidence) -> String {
         100.0 * e.residual_share,
         amplitude_text,
         e.margins.gain_margin.map_or("none (no crossing)".into(), |g| format!("{g:.2}")),
+        e.controller.kc_continuous,
+        seconds(e.controller.ti_continuous),
         e.controller.kc,
-        e.controller.ti.map_or("-".into(), |t| format!("{t:.0} s")),
+        seconds(e.controller.ti),
         e.controller.r2
     )
+}
+
+/// An integral time in words: seconds (a tenth under 10 s), or "-" when the fit gives none.
+fn seconds(t: Option<f64>) -> String {
+    match t {
+        Some(t) if t.abs() < 10.0 => format!("{t:.1} s"),
+        Some(t) => format!("{t:.0} s"),
+        None => "-".into(),
+    }
 }
