@@ -9,6 +9,7 @@ fn band_source(s: BandSource) -> &'static str {
         BandSource::Valve => "from the recorded valve position",
         BandSource::ClosedLoop => "closed-loop estimate, Stenman exact",
         BandSource::FitScan => "closed-loop fit's scan",
+        BandSource::SlipJumpFit => "closed-loop fit's slip-jump valve, Kano's S",
         BandSource::StickSlip => "median OP travel per stick",
         BandSource::DescribingFunction => "describing function of the limit cycle",
         BandSource::Levels => "levels test's best valve",

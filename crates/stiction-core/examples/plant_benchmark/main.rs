@@ -24,6 +24,7 @@
 //! The backlash-only valve is reported outside the goals. (Issue 14, fast): at least 95 % of the
 //! sticky loops called `stiction`; every look-alike class at least 95 % not called `stiction`.
 
+mod band;
 #[path = "../common/catalogue_loop.rs"]
 mod catalogue_loop;
 mod confidence;
@@ -217,6 +218,7 @@ fn run_suite(o: &Options, suite: Suite, md: &mut String, jsonl: &mut String) {
         );
     }
     sticky_table(md, &loops, &res);
+    band::band_table(md, &groups);
     confidence::confidence_table(md, &groups);
     if THOROUGH.load(std::sync::atomic::Ordering::Relaxed) {
         levels_table(md, &groups);

@@ -3,6 +3,7 @@
 //! (`Set::Extra`), each alone and pooled, beside the benchmark set: a threshold is chosen on the
 //! calibration draws, the benchmark only checks it.
 
+use super::band::band_table;
 use super::confidence::confidence_table;
 use super::tables::{by_class, goal_rows, GoalRow};
 use super::{judge, suite_title, Options};
@@ -90,7 +91,9 @@ fn spread_table(o: &Options, suite: Suite, extra: u8, md: &mut String) {
     }
     let _ = writeln!(md);
     let _ = writeln!(md, "Pooled over the calibration draws:\n");
-    confidence_table(md, &by_class(&pooled_loops, &pooled_res));
+    let pooled_groups = by_class(&pooled_loops, &pooled_res);
+    band_table(md, &pooled_groups);
+    confidence_table(md, &pooled_groups);
 }
 
 /// The page: every suite asked for, on `extra` further draws.

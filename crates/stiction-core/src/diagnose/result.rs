@@ -110,6 +110,8 @@ pub enum BandSource {
     ClosedLoop,
     /// The closed-loop fit's scan of the Stenman band (not the exact search).
     FitScan,
+    /// The band `S` of the closed-loop fit's slip-jump valve (Kano's, its jump `J` free).
+    SlipJumpFit,
     /// The median OP travel per stick of the stick-slip episodes.
     StickSlip,
     /// The band whose describing function closes the harmonic balance of the identified loop at
@@ -127,6 +129,7 @@ impl BandSource {
             BandSource::Valve => "from the recorded valve position",
             BandSource::ClosedLoop => "the closed-loop estimate (Stenman, exact)",
             BandSource::FitScan => "the closed-loop fit's scan of the Stenman band",
+            BandSource::SlipJumpFit => "the closed-loop fit's slip-jump valve (Kano's S)",
             BandSource::StickSlip => "the median OP travel per stick",
             BandSource::DescribingFunction => "the describing function of the loop's limit cycle",
             BandSource::Levels => "the levels test's best valve",
@@ -141,6 +144,7 @@ impl BandSource {
             BandSource::Valve => "valve",
             BandSource::ClosedLoop => "closed_loop",
             BandSource::FitScan => "fit_scan",
+            BandSource::SlipJumpFit => "slip_jump_fit",
             BandSource::StickSlip => "stick_slip",
             BandSource::DescribingFunction => "describing_function",
             BandSource::Levels => "levels",

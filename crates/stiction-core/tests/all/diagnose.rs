@@ -435,3 +435,26 @@ fn the_stiction_fit_is_also_polished_from_the_linear_loops_dynamics() {
     assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
 }
+
+#[test]
+fn where_the_stenman_fit_settles_near_op_the_slip_jump_band_is_reported() {
+    // routine-c-0094 of the catalogue's calibration set: a flow loop recorded every second, its
+    // Kano valve S = 2.12 %, J = 0.87 %. The closed-loop estimate (Stenman, exact) settles on a band
+    // near OP; the closed-loop fit's slip-jump valve finds S near the truth and is reported, the
+    // Stenman band beside it.
+    let d = judge_catalogue("routine-c-0094");
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let band = d.band.as_ref().unwrap();
+    assert_eq!(band.source, BandSource::SlipJumpFit, "{band:?}");
+    assert!(
+        (2.12 / 1.5..2.12 * 1.5).contains(&band.band_percent_of_span),
+        "{band:?}"
+    );
+    let closed = band
+        .others
+        .iter()
+        .find(|(s, _)| *s == BandSource::ClosedLoop)
+        .map(|(_, v)| *v)
+        .unwrap();
+    assert!(closed < band.band_percent_of_span / 1.2, "{band:?}");
+}
