@@ -436,18 +436,21 @@ fn the_stiction_fit_is_also_polished_from_the_linear_loops_dynamics() {
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
 }
 
-#[test]
-fn where_the_stenman_fit_settles_near_op_the_slip_jump_band_is_reported() {
-    // routine-c-0094 of the catalogue's calibration set: a flow loop recorded every second, its
-    // Kano valve S = 2.12 %, J = 0.87 %. The closed-loop estimate (Stenman, exact) settles on a band
-    // near OP; the closed-loop fit's slip-jump valve finds S near the truth and is reported, the
-    // Stenman band beside it.
-    let d = judge_catalogue("routine-c-0094");
+/// The catalogue loop `id`, called `stiction` with its band from `source`, within 1.5x of the
+/// simulated `truth` (% of span) and the closed-loop estimate beside it, more than `by` times
+/// smaller. Its diagnosis.
+pub(crate) fn band_replaces_the_closed_loop_estimate(
+    id: &str,
+    source: BandSource,
+    truth: f64,
+    by: f64,
+) -> stiction_core::diagnose::Diagnosis {
+    let d = judge_catalogue(id);
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
     let band = d.band.as_ref().unwrap();
-    assert_eq!(band.source, BandSource::SlipJumpFit, "{band:?}");
+    assert_eq!(band.source, source, "{band:?}");
     assert!(
-        (2.12 / 1.5..2.12 * 1.5).contains(&band.band_percent_of_span),
+        (truth / 1.5..truth * 1.5).contains(&band.band_percent_of_span),
         "{band:?}"
     );
     let closed = band
@@ -456,5 +459,15 @@ fn where_the_stenman_fit_settles_near_op_the_slip_jump_band_is_reported() {
         .find(|(s, _)| *s == BandSource::ClosedLoop)
         .map(|(_, v)| *v)
         .unwrap();
-    assert!(closed < band.band_percent_of_span / 1.2, "{band:?}");
+    assert!(closed < band.band_percent_of_span / by, "{band:?}");
+    d
+}
+
+#[test]
+fn where_the_stenman_fit_settles_near_op_the_slip_jump_band_is_reported() {
+    // routine-c-0094 of the catalogue's calibration set: a flow loop recorded every second, its
+    // Kano valve S = 2.12 %, J = 0.87 %. The closed-loop estimate (Stenman, exact) settles on a band
+    // near OP; the closed-loop fit's slip-jump valve finds S near the truth and is reported, the
+    // Stenman band beside it.
+    band_replaces_the_closed_loop_estimate("routine-c-0094", BandSource::SlipJumpFit, 2.12, 1.2);
 }
