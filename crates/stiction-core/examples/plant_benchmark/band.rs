@@ -30,7 +30,7 @@ pub(super) fn band_table(md: &mut String, groups: &Groups) {
         }
         all.extend_from_slice(&ratios);
         let mut by_count: Vec<(&str, usize)> = sources.into_iter().collect();
-        by_count.sort_by(|a, b| b.1.cmp(&a.1));
+        by_count.sort_by_key(|&(_, n)| std::cmp::Reverse(n));
         let words: Vec<String> = by_count.iter().map(|(s, n)| format!("{s} {n}")).collect();
         row(md, &class.to_string(), &mut ratios, &words.join(", "));
     }
