@@ -66,10 +66,10 @@ fn spread_table(o: &Options, suite: Suite, extra: u8, md: &mut String) {
             .filter_map(|r| r.get(i))
             .map(|g| g.value)
             .collect();
-        let short = |v: f64| short(v, p.share);
+        let cell = |v: f64| short(v, p.share);
         let cells: Vec<String> = per_draw
             .iter()
-            .map(|r| r.get(i).map_or("-".into(), |g| short(g.value)))
+            .map(|r| r.get(i).map_or("-".into(), |g| cell(g.value)))
             .collect();
         let (lo, hi) = values
             .iter()
@@ -84,8 +84,8 @@ fn spread_table(o: &Options, suite: Suite, extra: u8, md: &mut String) {
             cells.join(" | "),
             p.shown,
             if p.met { "met" } else { "missed" },
-            short(lo),
-            short(hi),
+            cell(lo),
+            cell(hi),
             bench_rows.get(i).map_or("-".into(), |g| g.shown.clone())
         );
     }
