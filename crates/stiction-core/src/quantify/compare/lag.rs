@@ -10,8 +10,17 @@ use super::{MAX_LAG_SHARE, MIN_LAG};
 /// [`MIN_CYCLE_GAIN`] of a regular cycle of the PV moves to the nearest odd multiple of half its
 /// period (the longer within `max_lag`, else the shorter), where the difference keeps all of it.
 /// `pv` is the PV with its trend removed ([`detrended`]).
-pub(super) fn off_the_cycle(lag: usize, pv: &[f64], max_lag: usize) -> usize {
-    let reg = crate::detect::regularity(pv, 1.0);
+#[cfg(test)]
+fn off_the_cycle(lag: usize, pv: &[f64], max_lag: usize) -> usize {
+    off_the_cycle_of(lag, &crate::detect::regularity(pv, 1.0), max_lag)
+}
+
+/// [`off_the_cycle`] from the regularity of the PV with its trend removed.
+pub(super) fn off_the_cycle_of(
+    lag: usize,
+    reg: &crate::detect::Regularity,
+    max_lag: usize,
+) -> usize {
     let Some(period) = reg.period.filter(|_| reg.oscillating) else {
         return lag;
     };

@@ -30,7 +30,7 @@ use crate::identify::{self, Data, Fit, SearchRange, Structure};
 use crate::models::{Kano, Model, Stenman};
 use band::{exact_band, valve_start};
 use fits::Fits;
-use lag::{detrended, half_correlation, off_the_cycle};
+use lag::{detrended, half_correlation, off_the_cycle_of};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -131,6 +131,9 @@ pub struct FitComparison {
 
 /// Bands (shares of the OP range) at which the linear structure is chosen again.
 const PILOT_BANDS: [f64; 2] = [0.02, 0.1];
+/// Thornhill's regularity of the PV (trend removed) from which it limit-cycles: its lag is then
+/// read off the cycle and may fall short of the process's delay (see `Setup::new`).
+const CYCLE_REGULARITY: f64 = 5.0;
 /// Structures refined towards the output-error optimum per compared fit.
 const REFINED_STRUCTURES: usize = 3;
 /// Steiglitz-McBride iterations towards each compared fit's output-error optimum.
@@ -162,7 +165,18 @@ pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitC
     let mut evaluations = 3;
     // the structures: the linear loop's, and those chosen at a few bands across the OP range
     let s0 = identify::select(&data, &setup.linear_mv, &setup.search)?.structure;
-    let structures = pilot_structures(&problem, &setup.search, s0, op_range, &mut evaluations)?;
+    let mut structures = pilot_structures(&problem, &setup.search, s0, op_range, &mut evaluations)?;
+    // (a limit cycle's search reaches the lag: the structure chosen short of it is tried too)
+    if let Some(short) = &setup.short_search {
+        if structures.iter().any(|s| reaches_the_lag(*s, setup.lag)) {
+            if let Some(sel) = identify::select(&data, &setup.linear_mv, short) {
+                if !structures.contains(&sel.structure) {
+                    structures.push(sel.structure);
+                }
+            }
+            evaluations += 1;
+        }
+    }
     let (x0, walked) = valve_start(op, &setup.y, setup.t0, setup.lag, &structures, op_range);
     evaluations += walked;
     let problem = Problem {
@@ -252,6 +266,8 @@ struct Setup {
     /// PV's changes over the lag, and OP's.
     y: Vec<f64>,
     linear_mv: Vec<f64>,
+    /// Where the PV limit-cycles: the search stopped short of the lag, tried beside the whole one.
+    short_search: Option<SearchRange>,
 }
 
 impl Setup {
@@ -274,6 +290,7 @@ impl Setup {
         // (an oscillating sticky loop's linear fit on levels is poor: its response time is read
         // off the PV's autocorrelation too, whichever is longer)
         let trendless = detrended(pv);
+        let reg = crate::detect::regularity(&trendless, 1.0);
         let mut lag = ((LAG_RESPONSES * response / req.ts).round() as usize)
             .max(half_correlation(&trendless));
         if first.integrating {
@@ -283,7 +300,7 @@ impl Setup {
         let max_lag = (n / MAX_LAG_SHARE).max(MIN_LAG);
         let lag = match req.lag {
             Some(l) => l.clamp(MIN_LAG, max_lag),
-            None => off_the_cycle(lag.clamp(MIN_LAG, max_lag), &trendless, max_lag),
+            None => off_the_cycle_of(lag.clamp(MIN_LAG, max_lag), &reg, max_lag),
         };
         if n < lag + t0 + 20 * (search.na.len() + search.nb_max + 1) {
             return None;
@@ -293,6 +310,28 @@ impl Setup {
         // whose simulation errors are those of the PV's changes, not of its noisy rate
         search.integrating = false;
         search.self_regulating = true;
+        // the valve's changes should stop short of the sample where PV's change starts. OP's
+        // change delayed by the lag, `op[t] - op[t - lag]`, ends at `pv[t]`; under feedback it is
+        // about minus the controller's gain times PV's change before: PV's own past in disguise,
+        // which the one-step selection prefers to the process (routine-c-0033 of the catalogue: a
+        // delay of the lag itself was chosen, gain 0.08 for 1.16, R² 0.27 with and without
+        // stiction; short of the lag, 0.44 without and 0.78 with the true band found). Where the
+        // PV does not limit-cycle, the lag is at least half again the response time, the delay
+        // lies well within it, and the search stops short of it. A limit cycle's lag is read off
+        // the cycle's autocorrelation and can fall short of the delay (issue 14's example: a lag
+        // of 20 s, a delay of 30 s); there the whole search stays and the short one is tried
+        // beside it.
+        let short = SearchRange {
+            nk_max: search.nk_max.min(lag.saturating_sub(search.nb_max)).max(1),
+            ..search.clone()
+        };
+        let limit_cycles = reg.oscillating && reg.regularity >= CYCLE_REGULARITY;
+        let short_search = if limit_cycles {
+            Some(short)
+        } else {
+            search = short;
+            None
+        };
         let mut y = vec![0.0; n - lag];
         difference(pv, lag, &mut y);
         let mut linear_mv = vec![0.0; n - lag];
@@ -305,8 +344,15 @@ impl Setup {
             op_centred,
             y,
             linear_mv,
+            short_search,
         })
     }
+}
+
+/// Whether a structure's input terms reach back to the lag: to the valve change that ends where
+/// the compared change of PV starts.
+fn reaches_the_lag(s: Structure, lag: usize) -> bool {
+    s.nk + s.nb > lag
 }
 
 /// The linear loop's structure and those chosen again with Stenman valves of a few bands.
