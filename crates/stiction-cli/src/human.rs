@@ -13,6 +13,7 @@ fn band_source(s: BandSource) -> &'static str {
         BandSource::StickSlip => "median OP travel per stick",
         BandSource::DescribingFunction => "describing function of the limit cycle",
         BandSource::Levels => "levels test's best valve",
+        BandSource::Ellipse => "width of the oscillation's PV-OP ellipse",
     }
 }
 

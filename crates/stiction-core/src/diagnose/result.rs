@@ -120,6 +120,9 @@ pub enum BandSource {
     /// The best valve of the model family's levels test (`thorough`): every Stenman valve, then
     /// He's near it, scored on PV's levels.
     Levels,
+    /// The width of the PV-OP ellipse of the oscillation (along OP), where the fits resolve no
+    /// band.
+    Ellipse,
 }
 
 impl BandSource {
@@ -133,6 +136,7 @@ impl BandSource {
             BandSource::StickSlip => "the median OP travel per stick",
             BandSource::DescribingFunction => "the describing function of the loop's limit cycle",
             BandSource::Levels => "the levels test's best valve",
+            BandSource::Ellipse => "the width of the oscillation's PV-OP ellipse",
         }
     }
 }
@@ -148,6 +152,7 @@ impl BandSource {
             BandSource::StickSlip => "stick_slip",
             BandSource::DescribingFunction => "describing_function",
             BandSource::Levels => "levels",
+            BandSource::Ellipse => "ellipse",
         }
     }
 }

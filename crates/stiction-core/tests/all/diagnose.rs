@@ -495,3 +495,26 @@ fn the_valves_changes_stop_short_of_the_sample_where_pvs_change_starts() {
     assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
 }
+
+#[test]
+fn a_band_under_the_ops_noise_is_none_the_fits_resolve_and_the_ellipse_stands_in() {
+    // fast-c-0010 of the catalogue's calibration set: a flow loop with a Stenman valve, d = 1.64 %,
+    // limit-cycling. The closed-loop estimate and the slip-jump fit find bands of 0.01 and 0.03 %,
+    // under twice the OP's noise: no band they resolve. The ellipse of the cycle (1.55 %) is
+    // reported, the fits' bands beside it.
+    let d = band_replaces_the_closed_loop_estimate("fast-c-0010", BandSource::Ellipse, 1.64, 10.0);
+    let band = d.band.as_ref().unwrap();
+    assert!(
+        band.others
+            .iter()
+            .any(|(s, v)| *s == BandSource::SlipJumpFit && *v < 0.1),
+        "{band:?}"
+    );
+    assert!(
+        d.warnings
+            .iter()
+            .any(|w| w.contains("the fits resolve no band")),
+        "{:?}",
+        d.warnings
+    );
+}
