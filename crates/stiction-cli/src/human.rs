@@ -52,7 +52,10 @@ fn headline(file: &str, d: &Diagnosis) {
             .iter()
             .map(|(s, v)| format!("{} {v:.2} %", band_source(*s)))
             .collect();
-        if let Some(e) = b.ellipse_percent_of_span {
+        if let Some(e) = b
+            .ellipse_percent_of_span
+            .filter(|_| b.source != BandSource::Ellipse)
+        {
             others.push(format!("ellipse {e:.2} %"));
         }
         println!(
