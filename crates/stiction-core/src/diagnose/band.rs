@@ -130,7 +130,10 @@ impl<'a> Beside<'a> {
             ellipse,
             self_sustained,
             levels,
-            op_noise: crate::detect::measurement_noise(sub.op),
+            // as the families measured it, on the same stretch
+            op_noise: family(Family::StickSlip)
+                .and_then(|f| f.stick_slip.as_ref())
+                .map_or_else(|| crate::detect::measurement_noise(sub.op), |s| s.op_noise),
         }
     }
 }
@@ -160,11 +163,11 @@ pub(super) fn size(
     let beside = Beside::new(d, sub, offset, osc, req.ts);
     let (stick, describing, ellipse) = (beside.stick, beside.describing, beside.ellipse);
     let (self_sustained, levels) = (beside.self_sustained, beside.levels);
-    let fallback = Fallback {
-        ellipse,
-        stick,
-        op_noise: beside.op_noise,
-    };
+    // what stands in for a band the fits do not resolve
+    let stand_in = ellipse
+        .map(|e| (e, BandSource::Ellipse))
+        .or(stick.map(|t| (t, BandSource::StickSlip)));
+    let op_noise = beside.op_noise;
     let mut band = beside.valve.map(|v| Band {
         band_percent_of_span: v.d_percent_of_span,
         op_units: v.d,
@@ -226,7 +229,7 @@ pub(super) fn size(
             band.others.push((BandSource::Levels, pct(l)));
         }
     }
-    unresolved(d, &mut band, &fallback, req);
+    unresolved(d, &mut band, stand_in, op_noise, req);
     if let Some(t) = stick.filter(|_| band.source != BandSource::StickSlip) {
         band.others.push((BandSource::StickSlip, pct(t)));
     }
@@ -264,35 +267,30 @@ pub(super) fn size(
     d.band = Some(band);
 }
 
-/// What stands in for a band the fits do not resolve (OP units), and the OP's noise.
-struct Fallback {
-    ellipse: Option<f64>,
-    stick: Option<f64>,
+/// Where the fits' band is under [`UNRESOLVED_NOISES`] of the OP's noise (`op_noise`, OP units),
+/// report `stand_in` (the ellipse's width, or else the stick-slip travel) instead, and say so.
+fn unresolved(
+    d: &mut Diagnosis,
+    band: &mut Band,
+    stand_in: Option<(f64, BandSource)>,
     op_noise: f64,
-}
-
-/// Where the fits' band is under [`UNRESOLVED_NOISES`] of the OP's noise, report the ellipse's
-/// width or else the stick-slip travel instead, and say so.
-fn unresolved(d: &mut Diagnosis, band: &mut Band, beside: &Fallback, req: &DiagnoseRequest) {
+    req: &DiagnoseRequest,
+) {
     let from_fits = matches!(
         band.source,
         BandSource::ClosedLoop | BandSource::FitScan | BandSource::SlipJumpFit
     );
-    if !from_fits || band.op_units >= UNRESOLVED_NOISES * beside.op_noise {
+    if !from_fits || band.op_units >= UNRESOLVED_NOISES * op_noise {
         return;
     }
-    let Some((by, source)) = beside
-        .ellipse
-        .map(|e| (e, BandSource::Ellipse))
-        .or(beside.stick.map(|t| (t, BandSource::StickSlip)))
-    else {
+    let Some((by, source)) = stand_in else {
         return;
     };
     d.warnings.push(format!(
         "the fits resolve no band ({:.3} % of span, {}, is under {UNRESOLVED_NOISES} OP noise standard deviations, {:.3} %): the band reported is {}",
         band.band_percent_of_span,
         band.source.words(),
-        req.percent_of_span(UNRESOLVED_NOISES * beside.op_noise),
+        req.percent_of_span(UNRESOLVED_NOISES * op_noise),
         source.words()
     ));
     replace(band, by, source, req);

@@ -30,10 +30,10 @@ pub const OP_TRAVEL_SIGMAS: f64 = 4.0;
 const STICTION_STRENGTH: f64 = 0.4;
 /// From this many episodes holding at least [`DECISIVE_SHARE`] of the OP's travel the vote is
 /// held with [`DECISIVE_STRENGTH`], enough to decide alone. On the catalogue's calibration set and
-/// nine more draws of it (4,200 not-sticky loops, 4,800 sticky ones), no not-sticky loop with 20
-/// episodes or more spends more than 66 % of the OP's travel in them (the highest: an
-/// equal-percentage valve, 66 %, an external oscillation, 62 %, a saturating OP, 64 %); 69 sticky
-/// loops and 1 of the 30-odd backlash valves with as many episodes spend 70 % or more.
+/// nine more draws of it (3,600 not-sticky loops, 3,300 sticky ones, 300 backlash valves), no
+/// not-sticky loop with 20 episodes or more spends more than 66 % of the OP's travel in them (the
+/// highest: an equal-percentage valve, 66 %, a saturating OP, 64 %, an external oscillation,
+/// 62 %); 36 sticky loops and 1 backlash valve reach 20 episodes holding 70 % or more.
 pub const DECISIVE_EPISODES: usize = 20;
 /// See [`DECISIVE_EPISODES`].
 pub const DECISIVE_SHARE: f64 = 0.7;
