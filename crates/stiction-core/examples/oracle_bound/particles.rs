@@ -32,10 +32,14 @@ struct Particle {
     ring: Vec<f64>,
     /// Errors summed since the last record.
     esum: f64,
+    /// The load's level and slope, where the filter knows only its model.
+    level: f64,
+    slope: f64,
 }
 
 /// What a step of the loop needs besides the particle.
 struct Step<'a> {
+    dt: f64,
     t: usize,
     j1: usize,
     sp: &'a [f64],
@@ -70,7 +74,8 @@ fn predicted_outputs(p: &Particle, s: &Step, noise: f64) -> f64 {
         q.ring[0] = mv;
         let position = if k >= s.nd { q.ring[s.nd] } else { s.x0 };
         q.process
-            .advance(s.setup.characteristic.flow(position) - s.flow0 + s.load[k]);
+            .advance(s.setup.characteristic.flow(position) - s.flow0 + s.load[k] + q.level);
+        q.level += q.slope * s.dt;
     }
     sum
 }
@@ -104,6 +109,7 @@ pub fn log_likelihood(
     pv: &[f64],
     n: usize,
     seed: u64,
+    load_known: bool,
 ) -> Option<Filtered> {
     let plan = Plan::new(setup);
     if plan.substeps != 1 || setup.noise <= 0.0 || setup.cascade.is_some() {
@@ -117,11 +123,21 @@ pub fn log_likelihood(
         .as_ref()
         .map(|d| d.generate(dt, steps))
         .unwrap_or_else(|| vec![0.0; steps]);
-    let load = setup
+    let mut load = setup
         .load
         .as_ref()
         .map(|d| d.generate(dt, steps))
         .unwrap_or_else(|| vec![0.0; steps]);
+    // a drift's model instead of its path: each particle carries a level and a slope
+    let drift = match &setup.load {
+        Some(stiction_core::sim::Signal::IntegratedRandomWalk {
+            slope_std, offset, ..
+        }) if !load_known => {
+            load.iter_mut().for_each(|v| *v = 0.0);
+            Some((*offset, slope_std * dt.sqrt()))
+        }
+        _ => None,
+    };
     let nd = (setup.process.delay() / dt).round() as usize;
     let pv0 = sp.first().copied().unwrap_or(0.0);
     let (valve, x0) = model.start(setup.op0);
@@ -155,7 +171,13 @@ pub fn log_likelihood(
         stem: x0,
         ring: vec![x0; nd + 1],
         esum: 0.0,
+        level: 0.0,
+        slope: 0.0,
     };
+    let mut start = start;
+    if let Some((offset, _)) = drift {
+        start.level = offset;
+    }
     let mut ps = vec![start; n];
     let mut logw = vec![0.0; n];
     let mut rng = seeded(seed);
@@ -186,6 +208,7 @@ pub fn log_likelihood(
                     let ys = predicted_outputs(
                         p,
                         &Step {
+                            dt,
                             t,
                             j1,
                             sp: &sp,
@@ -242,7 +265,11 @@ pub fn log_likelihood(
             p.ring[0] = mv;
             let position = if t >= nd { p.ring[nd] } else { x0 };
             p.process
-                .advance(setup.characteristic.flow(position) - flow0 + load[t]);
+                .advance(setup.characteristic.flow(position) - flow0 + load[t] + p.level);
+            if let Some((_, kick)) = drift {
+                p.level += p.slope * dt;
+                p.slope += kick * gaussian(&mut rng);
+            }
         }
         if let Some(j) = rec {
             let top = logw.iter().copied().fold(f64::NEG_INFINITY, f64::max);
