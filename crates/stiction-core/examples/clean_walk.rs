@@ -280,11 +280,7 @@ fn table(rows: &[Row], set: Set, suite: Suite) -> String {
 fn main() {
     let args = StudyArgs::from_env("clean_walk");
     let set = args.set();
-    let suite = match args.value("--suite") {
-        None | Some("routine") => Suite::Routine,
-        Some("fast") => Suite::Fast,
-        Some(other) => args.fail(&format!("--suite {other}: use routine or fast")),
-    };
+    let suite = args.suite();
     let loops = catalogue::catalogue(suite, set);
     let rows: Vec<Row> = loops.par_iter().map(judge).collect();
     if let Some(path) = args.value("--jsonl") {

@@ -2,7 +2,7 @@
 //! the calibration seeds), `--out FILE` (the table to a file instead of standard output) and
 //! other `--flag VALUE` pairs.
 
-use stiction_core::sim::catalogue::Set;
+use stiction_core::sim::catalogue::{Set, Suite};
 
 /// The study's arguments.
 pub struct StudyArgs {
@@ -34,6 +34,16 @@ impl StudyArgs {
             Set::Benchmark
         } else {
             Set::Calibration
+        }
+    }
+
+    /// The suite of `--suite routine|fast` (routine when not given); exit 2 on another name.
+    #[allow(dead_code)]
+    pub fn suite(&self) -> Suite {
+        match self.value("--suite") {
+            None | Some("routine") => Suite::Routine,
+            Some("fast") => Suite::Fast,
+            Some(other) => self.fail(&format!("--suite {other}: use routine or fast")),
         }
     }
 

@@ -169,6 +169,11 @@ fn share(v: impl Iterator<Item = bool>) -> (usize, usize) {
     v.fold((0, 0), |(k, n), b| (k + b as usize, n + 1))
 }
 
+/// The balanced accuracy of sticky loops called sticky (`hit`) and twins called healthy (`twin`).
+fn balanced(hit: (usize, usize), twin: (usize, usize)) -> f64 {
+    0.5 * (hit.0 as f64 / hit.1.max(1) as f64 + twin.0 as f64 / twin.1.max(1) as f64)
+}
+
 fn pct((k, n): (usize, usize)) -> String {
     format!("{:.1} % ({k} of {n})", 100.0 * k as f64 / n.max(1) as f64)
 }
@@ -182,7 +187,7 @@ fn table(md: &mut String, rows: &[&Row], healthy: &[Llr]) {
     for (name, pick) in ORACLES {
         let hit = share(rows.iter().map(|r| pick(&r.sticky) > 0.0));
         let twin = share(rows.iter().map(|r| pick(&r.twin) <= 0.0));
-        let ba = 0.5 * (hit.0 as f64 / hit.1.max(1) as f64 + twin.0 as f64 / twin.1.max(1) as f64);
+        let ba = balanced(hit, twin);
         let h = if healthy.is_empty() {
             "-".to_string()
         } else {
@@ -321,8 +326,7 @@ fn hidden_table(md: &mut String, rows: &[Row], particles: usize) {
         ] {
             let hit = share(part.iter().map(|h| h.0 > 0.0));
             let twin = share(part.iter().map(|h| h.1 <= 0.0));
-            let ba =
-                0.5 * (hit.0 as f64 / hit.1.max(1) as f64 + twin.0 as f64 / twin.1.max(1) as f64);
+            let ba = balanced(hit, twin);
             let _ = writeln!(
                 md,
                 "| {load} | {words} ({}) | {} | {} | {ba:.3} |",

@@ -1,7 +1,7 @@
 //! The oracles without the band, and the one that sees OP only at the recorded samples.
 
 use super::kalman::{llrs, FullRun, Llr};
-use super::{pct, share, Pick, Row, ORACLES};
+use super::{balanced, pct, share, Pick, Row, ORACLES};
 use std::fmt::Write as _;
 use stiction_core::models::{Model, Stenman};
 use stiction_core::sim::ClosedLoop;
@@ -91,9 +91,6 @@ pub fn unknown_table(md: &mut String, rows: &[Row], bands: usize) {
             let known_twin = share(part.iter().map(|(r, _)| pick(&r.twin) <= 0.0));
             let hit = share(part.iter().map(|(_, u)| pick(&u.sticky) > 0.0));
             let twin = share(part.iter().map(|(_, u)| pick(&u.twin) <= 0.0));
-            let ba = |h: (usize, usize), t: (usize, usize)| {
-                0.5 * (h.0 as f64 / h.1.max(1) as f64 + t.0 as f64 / t.1.max(1) as f64)
-            };
             let _ = writeln!(
                 md,
                 "| {name} | {words} | {} | {} | {} | {} | {:.3} | {:.3} |",
@@ -101,8 +98,8 @@ pub fn unknown_table(md: &mut String, rows: &[Row], bands: usize) {
                 pct(hit),
                 pct(known_twin),
                 pct(twin),
-                ba(known_hit, known_twin),
-                ba(hit, twin)
+                balanced(known_hit, known_twin),
+                balanced(hit, twin)
             );
         }
     }
@@ -120,9 +117,6 @@ pub fn unknown_table(md: &mut String, rows: &[Row], bands: usize) {
         let kt = share(part.iter().map(|u| u.held_known.1 <= 0.0));
         let h = share(part.iter().map(|u| u.held.0 > 0.0));
         let t = share(part.iter().map(|u| u.held.1 <= 0.0));
-        let ba = |h: (usize, usize), t: (usize, usize)| {
-            0.5 * (h.0 as f64 / h.1.max(1) as f64 + t.0 as f64 / t.1.max(1) as f64)
-        };
         let _ = writeln!(
             md,
             "| load's model known, OP and PV at the recorded samples | {words} | {} | {} | {} | {} | {:.3} | {:.3} |",
@@ -130,8 +124,8 @@ pub fn unknown_table(md: &mut String, rows: &[Row], bands: usize) {
             pct(h),
             pct(kt),
             pct(t),
-            ba(kh, kt),
-            ba(h, t)
+            balanced(kh, kt),
+            balanced(h, t)
         );
     }
 }
