@@ -31,6 +31,7 @@
 //! band: the likelihood of a Stenman valve averaged over N bands log-uniform in the suite's range
 //! (0.5-5 % of span), against a healthy valve. With the prior right, that is the best test of all
 //! that do not know the band. Beside it, one oracle that sees OP too only at the recorded samples
+mod hidden;
 mod kalman;
 mod particles;
 #[path = "../common/study_args.rs"]
@@ -80,7 +81,7 @@ struct Row {
     /// The particle filter's log-likelihood ratios (sticky loop, twin), Stenman loops of 10 s,
     /// and whether the filter under the valve each record has kept track of it.
     /// (With the load's path known, with its model only.)
-    hidden: Option<[(f64, f64, bool); 2]>,
+    hidden: Option<hidden::Hidden>,
 }
 
 fn judge(l: &BenchmarkLoop, bands: usize, particles: usize) -> Row {
@@ -113,37 +114,7 @@ fn judge(l: &BenchmarkLoop, bands: usize, particles: usize) -> Row {
         }
     });
     let hidden = (particles > 0 && l.class == LoopClass::StenmanValve && l.setup.ts >= 5.0)
-        .then(|| {
-            let twin_data = twin_setup.run().ok()?;
-            let healthy = Model::Stenman(Stenman { d: 0.0 });
-            // the ratio, and whether the filter under the valve the loop has kept track
-            let llr = |setup: &stiction_core::sim::ClosedLoop,
-                       op: &[f64],
-                       pv: &[f64],
-                       sticky: bool,
-                       known: bool| {
-                let seed = setup.seed ^ 0x5eed;
-                let a = particles::log_likelihood(
-                    setup,
-                    &l.setup.model,
-                    op,
-                    pv,
-                    particles,
-                    seed,
-                    known,
-                )?;
-                let b = particles::log_likelihood(setup, &healthy, op, pv, particles, seed, known)?;
-                let lost = if sticky { a.lost } else { b.lost };
-                Some((a.log_likelihood - b.log_likelihood, lost <= TRACKED))
-            };
-            let pair = |known: bool| -> Option<(f64, f64, bool)> {
-                let (sticky, kept) = llr(&l.setup, &l.data.op, &l.data.pv, true, known)?;
-                let (twin, twin_kept) =
-                    llr(&twin_setup, &twin_data.op, &twin_data.pv, false, known)?;
-                Some((sticky, twin, kept && twin_kept))
-            };
-            Some([pair(true)?, pair(false)?])
-        })
+        .then(|| hidden::hidden(l, &twin_setup, particles))
         .flatten();
     Row {
         hidden,
@@ -287,53 +258,7 @@ fn main() {
         unknown_table(&mut md, &rows, bands);
     }
     if particles > 0 {
-        hidden_table(&mut md, &rows, particles);
+        hidden::hidden_table(&mut md, &rows, particles);
     }
     args.emit(&md);
-}
-
-/// The share of records at which a filter may have lost track before its estimate is set aside.
-const TRACKED: f64 = 0.01;
-
-fn hidden_table(md: &mut String, rows: &[Row], particles: usize) {
-    let all: Vec<&[(f64, f64, bool); 2]> = rows.iter().filter_map(|r| r.hidden.as_ref()).collect();
-    let _ = writeln!(
-        md,
-        "\n## OP and PV at the recorded samples, what happens between them hidden (Stenman loops of 750 samples every 10 s, {particles} particles)\n\n\
-         A particle filter over the whole loop (see `particles.rs`): the process, controller, noise, setpoint, the valve model and the load's path (or, for a drift, only its model) known; \
-         the measurement noise the controller saw between the records hidden. With the load's path known this is more than any method has; with a drift's model only, no more than the first oracles. \
-         The filter's estimate is biased low where it loses track of PV (every particle 10 noise standard deviations away from the record): \
-         under the wrong valve that is the evidence itself, under the valve the loop has it makes the ratio uncertain. The rows \"kept track\" keep the loops \
-         whose filter under their own valve lost track at no more than 1 % of the records.\n"
-    );
-    let _ = writeln!(
-        md,
-        "| load | loops | sticky called stiction | twins called healthy | balanced accuracy |"
-    );
-    let _ = writeln!(md, "|---|---|---|---|---|");
-    for (i, load) in [
-        "its path known",
-        "its model known (a drift's level and slope in each particle)",
-    ]
-    .iter()
-    .enumerate()
-    {
-        let every: Vec<(f64, f64, bool)> = all.iter().map(|h| h[i]).collect();
-        let tracked: Vec<(f64, f64, bool)> = every.iter().copied().filter(|h| h.2).collect();
-        for (words, part) in [
-            ("all", &every),
-            ("the filter under the loop's own valve kept track", &tracked),
-        ] {
-            let hit = share(part.iter().map(|h| h.0 > 0.0));
-            let twin = share(part.iter().map(|h| h.1 <= 0.0));
-            let ba = balanced(hit, twin);
-            let _ = writeln!(
-                md,
-                "| {load} | {words} ({}) | {} | {} | {ba:.3} |",
-                part.len(),
-                pct(hit),
-                pct(twin)
-            );
-        }
-    }
 }

@@ -17,8 +17,8 @@
 
 use rand::RngExt;
 use stiction_core::models::{Model, ModelState};
-use stiction_core::rng::{gaussian, seeded};
-use stiction_core::sim::{ClosedLoop, Plan, ProcessState, ValveLag};
+use stiction_core::rng::{gaussian, seeded, Rng};
+use stiction_core::sim::{ClosedLoop, Plan, ProcessState, Signal, ValveLag};
 
 #[derive(Clone)]
 struct Particle {
@@ -37,47 +37,151 @@ struct Particle {
     slope: f64,
 }
 
-/// What a step of the loop needs besides the particle.
-struct Step<'a> {
+/// The loop as the filter knows it: signals at every plant step and the constants of a step.
+struct Loop<'a> {
+    setup: &'a ClosedLoop,
+    model: &'a Model,
     dt: f64,
-    t: usize,
-    j1: usize,
-    sp: &'a [f64],
-    dist: &'a [f64],
-    load: &'a [f64],
+    sp: Vec<f64>,
+    dist: Vec<f64>,
+    /// The load's path, or zeros where the particles carry a drift's level and slope.
+    load: Vec<f64>,
+    /// A drift's kick per step, where the particles carry it.
+    kick: Option<f64>,
     pv0: f64,
     kc: f64,
     ki: f64,
     nd: usize,
     x0: f64,
     flow0: f64,
-    setup: &'a ClosedLoop,
-    model: &'a Model,
+    var: f64,
+    /// Suffix sums of the error's known part, `sp - pv0 - dist`.
+    known: Vec<f64>,
 }
 
-/// The sum of the process outputs from step `t` to the step before `j1`, the particle run on
-/// with every measurement noise `noise`.
-fn predicted_outputs(p: &Particle, s: &Step, noise: f64) -> f64 {
-    let mut q = p.clone();
-    let mut sum = 0.0;
-    for k in s.t..s.j1 {
-        let y = q.process.output();
-        sum += y;
-        let e = s.sp[k] - (s.pv0 + y + s.dist[k] + noise);
-        if k > 0 {
-            q.op = (q.op + s.kc * (e - q.e) + s.ki * e).clamp(0.0, 100.0);
-            q.stem = s.model.step(&mut q.valve, q.op);
+impl<'a> Loop<'a> {
+    fn new(setup: &'a ClosedLoop, model: &'a Model, plan: &Plan, load_known: bool) -> Self {
+        let (steps, dt) = (plan.steps, plan.dt);
+        let path = |s: &Option<Signal>| {
+            s.as_ref()
+                .map(|d| d.generate(dt, steps))
+                .unwrap_or_else(|| vec![0.0; steps])
+        };
+        let sp = setup.setpoint.generate(dt, steps);
+        let dist = path(&setup.disturbance);
+        let drift = match &setup.load {
+            Some(Signal::IntegratedRandomWalk { slope_std, .. }) if !load_known => {
+                Some(slope_std * dt.sqrt())
+            }
+            _ => None,
+        };
+        let load = if drift.is_some() {
+            vec![0.0; steps]
+        } else {
+            path(&setup.load)
+        };
+        let pv0 = sp.first().copied().unwrap_or(0.0);
+        let mut known = vec![0.0; steps + 1];
+        for t in (0..steps).rev() {
+            known[t] = known[t + 1] + sp[t] - pv0 - dist[t];
         }
-        q.e = e;
-        let mv = if k == 0 { s.x0 } else { q.lag.step(q.stem) };
-        q.ring.rotate_right(1);
-        q.ring[0] = mv;
-        let position = if k >= s.nd { q.ring[s.nd] } else { s.x0 };
-        q.process
-            .advance(s.setup.characteristic.flow(position) - s.flow0 + s.load[k] + q.level);
-        q.level += q.slope * s.dt;
+        let x0 = model.start(setup.op0).1;
+        Self {
+            setup,
+            model,
+            dt,
+            sp,
+            dist,
+            load,
+            kick: drift,
+            pv0,
+            kc: setup.pi.kc,
+            ki: setup.pi.kc * plan.h / setup.pi.ti,
+            nd: (setup.process.delay() / dt).round() as usize,
+            x0,
+            flow0: setup.characteristic.flow(x0),
+            var: setup.noise * setup.noise,
+            known,
+        }
     }
-    sum
+
+    fn start(&self) -> Particle {
+        let (valve, x0) = self.model.start(self.setup.op0);
+        Particle {
+            process: self.setup.process.discretise(self.dt),
+            valve,
+            lag: ValveLag::new(self.setup.valve_lag, self.dt, x0),
+            op: self.setup.op0,
+            e: 0.0,
+            stem: x0,
+            ring: vec![x0; self.nd + 1],
+            esum: 0.0,
+            level: match &self.setup.load {
+                Some(Signal::IntegratedRandomWalk { offset, .. }) if self.kick.is_some() => *offset,
+                _ => 0.0,
+            },
+            slope: 0.0,
+        }
+    }
+
+    /// The error the controller sees at step `t` with measurement noise `noise`.
+    fn error(&self, p: &Particle, t: usize, noise: f64) -> f64 {
+        self.sp[t] - (self.pv0 + p.process.output() + self.dist[t] + noise)
+    }
+
+    /// One plant step after the measurement: the controller acts on `e`, the valve and its lag
+    /// follow, the process advances (the drift's slope is kicked by the caller).
+    fn advance(&self, p: &mut Particle, t: usize, e: f64) {
+        if t > 0 {
+            p.op = (p.op + self.kc * (e - p.e) + self.ki * e).clamp(0.0, 100.0);
+            p.stem = self.model.step(&mut p.valve, p.op);
+        }
+        p.e = e;
+        let mv = if t == 0 { self.x0 } else { p.lag.step(p.stem) };
+        p.ring.rotate_right(1);
+        p.ring[0] = mv;
+        let position = if t >= self.nd {
+            p.ring[self.nd]
+        } else {
+            self.x0
+        };
+        let flow = self.setup.characteristic.flow(position) - self.flow0;
+        p.process.advance(flow + self.load[t] + p.level);
+        p.level += p.slope * self.dt;
+    }
+
+    /// The sum of the process outputs from step `t` to the step before `j1`, the particle run
+    /// on with every measurement noise `noise`.
+    fn predicted_outputs(&self, p: &Particle, t: usize, j1: usize, noise: f64) -> f64 {
+        let mut q = p.clone();
+        let mut sum = 0.0;
+        for k in t..j1 {
+            sum += q.process.output();
+            let e = self.error(&q, k, noise);
+            self.advance(&mut q, k, e);
+        }
+        sum
+    }
+
+    /// The noise at an unrecorded step `t` between records, drawn from the bridge towards the
+    /// errors' sum `target` by the next record `j1`, and its log weight.
+    fn bridge(&self, p: &Particle, t: usize, j1: usize, target: f64, rng: &mut Rng) -> (f64, f64) {
+        let r = j1 - t;
+        let remaining = target - p.esum;
+        let known = self.known[t] - self.known[j1];
+        // the noises still to come must sum to this for the errors to reach the target: the
+        // process outputs predicted by running the particle on with each noise at its share
+        // (from the output held), the last noise closing the sum exactly
+        let held = known - r as f64 * p.process.output() - remaining;
+        if r == 1 {
+            return (held, ln_normal(held, self.var));
+        }
+        let ys = self.predicted_outputs(p, t, j1, held / r as f64);
+        let mean = (known - ys - remaining) / r as f64;
+        let pvar = self.var * (1.0 - 1.0 / r as f64);
+        let v = mean + pvar.sqrt() * gaussian(rng);
+        (v, ln_normal(v, self.var) - ln_normal(v - mean, pvar))
+    }
 }
 
 const LN_2PI: f64 = 1.837_877_066_409_345_4;
@@ -89,6 +193,8 @@ fn ln_normal(x: f64, var: f64) -> f64 {
 /// A record's increment of the log-likelihood under which the filter has lost track: every
 /// particle about 10 noise standard deviations from the recorded PV.
 const LOST: f64 = -50.0;
+/// How far a particle's OP may miss the record (clamped at a limit between records), OP units.
+const OP_MISS: f64 = 0.05;
 
 /// The filter's estimate.
 pub struct Filtered {
@@ -99,9 +205,34 @@ pub struct Filtered {
     pub lost: f64,
 }
 
+/// Systematic resampling of `ps` by the log weights `logw` (reset to 0); the mean weight's log.
+fn resample(ps: &mut Vec<Particle>, logw: &mut [f64], rng: &mut Rng) -> Option<f64> {
+    let n = ps.len();
+    let top = logw.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !top.is_finite() {
+        return None;
+    }
+    let sum: f64 = logw.iter().map(|w| (w - top).exp()).sum();
+    let u0: f64 = rng.random::<f64>() / n as f64;
+    let mut out = Vec::with_capacity(n);
+    let (mut c, mut i) = ((logw[0] - top).exp() / sum, 0);
+    for k in 0..n {
+        let u = u0 + k as f64 / n as f64;
+        while u > c && i + 1 < n {
+            i += 1;
+            c += (logw[i] - top).exp() / sum;
+        }
+        out.push(ps[i].clone());
+    }
+    *ps = out;
+    logw.iter_mut().for_each(|w| *w = 0.0);
+    Some(top + (sum / n as f64).ln())
+}
+
 /// The log-likelihood of the record (`op`, `pv` at the plan's recorded steps) under the valve
-/// `model`, by a particle filter of `n` particles; `None` where the plant is stepped more than
-/// once per controller execution, the loop is a cascade's inner loop or the noise is zero.
+/// `model`, by a particle filter of `n` particles, with the load's path known or (a drift) only
+/// its model; `None` where the plant is stepped more than once per controller execution, the
+/// loop is a cascade's inner loop or the noise is zero.
 pub fn log_likelihood(
     setup: &ClosedLoop,
     model: &Model,
@@ -115,35 +246,8 @@ pub fn log_likelihood(
     if plan.substeps != 1 || setup.noise <= 0.0 || setup.cascade.is_some() {
         return None;
     }
+    let lp = Loop::new(setup, model, &plan, load_known);
     let steps = plan.steps;
-    let dt = plan.dt;
-    let sp = setup.setpoint.generate(dt, steps);
-    let dist = setup
-        .disturbance
-        .as_ref()
-        .map(|d| d.generate(dt, steps))
-        .unwrap_or_else(|| vec![0.0; steps]);
-    let mut load = setup
-        .load
-        .as_ref()
-        .map(|d| d.generate(dt, steps))
-        .unwrap_or_else(|| vec![0.0; steps]);
-    // a drift's model instead of its path: each particle carries a level and a slope
-    let drift = match &setup.load {
-        Some(stiction_core::sim::Signal::IntegratedRandomWalk {
-            slope_std, offset, ..
-        }) if !load_known => {
-            load.iter_mut().for_each(|v| *v = 0.0);
-            Some((*offset, slope_std * dt.sqrt()))
-        }
-        _ => None,
-    };
-    let nd = (setup.process.delay() / dt).round() as usize;
-    let pv0 = sp.first().copied().unwrap_or(0.0);
-    let (valve, x0) = model.start(setup.op0);
-    let flow0 = setup.characteristic.flow(x0);
-    let (kc, ki) = (setup.pi.kc, setup.pi.kc * plan.h / setup.pi.ti);
-    let var = setup.noise * setup.noise;
     // the record at each step, and the next record's step
     let mut rec_at = vec![None; steps];
     for (j, &s) in plan.recorded.iter().enumerate() {
@@ -157,152 +261,54 @@ pub fn log_likelihood(
         }
         next[t] = upcoming;
     }
-    // suffix sums of the known part of the error, `sp - pv0 - dist`
-    let mut known = vec![0.0; steps + 1];
-    for t in (0..steps).rev() {
-        known[t] = known[t + 1] + sp[t] - pv0 - dist[t];
-    }
-    let start = Particle {
-        process: setup.process.discretise(dt),
-        valve,
-        lag: ValveLag::new(setup.valve_lag, dt, x0),
-        op: setup.op0,
-        e: 0.0,
-        stem: x0,
-        ring: vec![x0; nd + 1],
-        esum: 0.0,
-        level: 0.0,
-        slope: 0.0,
-    };
-    let mut start = start;
-    if let Some((offset, _)) = drift {
-        start.level = offset;
-    }
-    let mut ps = vec![start; n];
+    let mut ps = vec![lp.start(); n];
     let mut logw = vec![0.0; n];
     let mut rng = seeded(seed);
-    let mut total = 0.0;
-    let mut lost = 0usize;
+    let (mut total, mut lost) = (0.0, 0usize);
     // the errors' sum between the last record and the next (set at each record)
-    let mut target_sum = f64::NAN;
-    let mut last_record: Option<usize> = None;
+    let mut target = None;
     for t in 0..steps {
         let rec = rec_at[t];
-        let j1 = next[t];
-        let bridged = rec.is_none() && last_record.is_some() && j1 != usize::MAX;
+        let bridged = target.filter(|_| rec.is_none() && next[t] != usize::MAX);
         for (p, w) in ps.iter_mut().zip(logw.iter_mut()) {
-            let y = p.process.output();
-            let noise = if let Some(j) = rec {
-                let v = pv[j] - (pv0 + y + dist[t]);
-                *w += ln_normal(v, var);
-                v
-            } else if bridged {
-                let r = j1 - t;
-                let remaining = target_sum - p.esum;
-                // sum of the noises still to come so that the errors sum to the target: the
-                // process output predicted by running the particle on to the next record with
-                // each noise at the sum's share (from the output held at y), then its last
-                // noise closes the sum exactly
-                let held = (known[t] - known[j1]) - r as f64 * y - remaining;
-                let total_noise = if r > 1 {
-                    let ys = predicted_outputs(
-                        p,
-                        &Step {
-                            dt,
-                            t,
-                            j1,
-                            sp: &sp,
-                            dist: &dist,
-                            load: &load,
-                            pv0,
-                            kc,
-                            ki,
-                            nd,
-                            x0,
-                            flow0,
-                            setup,
-                            model,
-                        },
-                        held / r as f64,
-                    );
-                    (known[t] - known[j1]) - ys - remaining
-                } else {
-                    held
-                };
-                if r > 1 {
-                    let mean = total_noise / r as f64;
-                    let pvar = var * (1.0 - 1.0 / r as f64);
-                    let v = mean + pvar.sqrt() * gaussian(&mut rng);
-                    *w += ln_normal(v, var) - ln_normal(v - mean, pvar);
+            let noise = match (rec, bridged) {
+                (Some(j), _) => {
+                    let v = pv[j] - (lp.pv0 + p.process.output() + lp.dist[t]);
+                    *w += ln_normal(v, lp.var);
                     v
-                } else {
-                    *w += ln_normal(total_noise, var);
-                    total_noise
                 }
-            } else {
-                setup.noise * gaussian(&mut rng)
+                (None, Some(sum)) => {
+                    let (v, lw) = lp.bridge(p, t, next[t], sum, &mut rng);
+                    *w += lw;
+                    v
+                }
+                (None, None) => setup.noise * gaussian(&mut rng),
             };
-            let e = sp[t] - (pv0 + y + dist[t] + noise);
-            if t > 0 {
-                p.op = (p.op + kc * (e - p.e) + ki * e).clamp(0.0, 100.0);
-                p.stem = model.step(&mut p.valve, p.op);
-            }
-            p.e = e;
-            if bridged {
+            let e = lp.error(p, t, noise);
+            lp.advance(p, t, e);
+            if bridged.is_some() {
                 p.esum += e;
             }
             if let Some(j) = rec {
                 // the bridge lands OP on the record unless OP was clamped on the way
                 let miss = p.op - op[j];
-                if miss.abs() > 1e-6 {
-                    *w += ln_normal(miss, 0.05 * 0.05) - ln_normal(0.0, 0.05 * 0.05);
-                }
+                *w += ln_normal(miss, OP_MISS * OP_MISS) - ln_normal(0.0, OP_MISS * OP_MISS);
                 p.op = op[j];
                 p.esum = 0.0;
             }
-            let mv = if t == 0 { x0 } else { p.lag.step(p.stem) };
-            p.ring.rotate_right(1);
-            p.ring[0] = mv;
-            let position = if t >= nd { p.ring[nd] } else { x0 };
-            p.process
-                .advance(setup.characteristic.flow(position) - flow0 + load[t] + p.level);
-            if let Some((_, kick)) = drift {
-                p.level += p.slope * dt;
+            if let Some(kick) = lp.kick {
                 p.slope += kick * gaussian(&mut rng);
             }
         }
         if let Some(j) = rec {
-            let top = logw.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            if !top.is_finite() {
-                return None;
-            }
-            let sum: f64 = logw.iter().map(|w| (w - top).exp()).sum();
-            let increment = top + (sum / n as f64).ln();
+            let increment = resample(&mut ps, &mut logw, &mut rng)?;
             total += increment;
-            // every particle 10 noise standard deviations or more away from the record
             lost += usize::from(increment < LOST);
-            // systematic resampling
-            let weights: Vec<f64> = logw.iter().map(|w| (w - top).exp() / sum).collect();
-            let u0: f64 = rng.random::<f64>() / n as f64;
-            let mut out = Vec::with_capacity(n);
-            let (mut c, mut i) = (weights[0], 0);
-            for k in 0..n {
-                let u = u0 + k as f64 / n as f64;
-                while u > c && i + 1 < n {
-                    i += 1;
-                    c += weights[i];
-                }
-                out.push(ps[i].clone());
-            }
-            ps = out;
-            logw.iter_mut().for_each(|w| *w = 0.0);
-            // the errors between this record and the next must sum to C
-            if let Some(&j2) = plan.recorded.get(j + 1) {
-                let e0 = sp[t] - pv[j];
-                let e1 = sp[j2] - pv[j + 1];
-                target_sum = (op[j + 1] - op[j] - kc * (e1 - e0)) / ki - e1;
-            }
-            last_record = Some(t);
+            // the errors between this record and the next sum to C (the module's docs)
+            target = plan.recorded.get(j + 1).map(|&j2| {
+                let (e0, e1) = (lp.sp[t] - pv[j], lp.sp[j2] - pv[j + 1]);
+                (op[j + 1] - op[j] - lp.kc * (e1 - e0)) / lp.ki - e1
+            });
         }
     }
     Some(Filtered {
