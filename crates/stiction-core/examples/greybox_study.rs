@@ -125,8 +125,8 @@ impl Filter {
     }
 
     /// The concentrated log-likelihood with the valve `u` (centred), K and the noise's variance
-    /// profiled out; and K.
-    fn ll(&self, u: &[f64]) -> (f64, f64) {
+    /// profiled out.
+    fn ll(&self, u: &[f64]) -> f64 {
         let (a, c, bf) = (self.a, self.c, self.bf);
         let mut x = [0.0f64; 3];
         let (mut s00, mut s0g, mut sgg, mut sl) = (0.0, 0.0, 0.0, 0.0);
@@ -156,10 +156,7 @@ impl Filter {
         }
         let kk = if sgg > 0.0 { s0g / sgg } else { 0.0 };
         let s1 = (s00 - kk * s0g).max(1e-300);
-        (
-            -0.5 * m as f64 * (s1 / m as f64).ln() - 0.5 * sl - 0.5 * m as f64,
-            kk,
-        )
+        -0.5 * m as f64 * (s1 / m as f64).ln() - 0.5 * sl - 0.5 * m as f64
     }
 }
 
@@ -181,7 +178,7 @@ fn grid_fit(y: &[f64], u: &[f64], integ: bool, thetas: &[usize]) -> (f64, usize,
             for j in 0..QS {
                 let lq = (1e-9f64).ln() + j as f64 / (QS - 1) as f64 * (1e8f64).ln();
                 let f = Filter::new(y, integ, th, lt, lq);
-                let (l, _) = f.ll(u);
+                let l = f.ll(u);
                 if l > best.0 {
                     best = (l, th, lt, lq);
                 }
@@ -237,7 +234,7 @@ fn judge(l: &BenchmarkLoop) -> Row {
         }
     }
     let filter = Filter::new(&y, integ, coarse.1, coarse.2, coarse.3);
-    let l0_held = filter.ll(&u).0;
+    let l0_held = filter.ll(&u);
     let mut fine = Vec::new();
     let mut best = (f64::NEG_INFINITY, 0.0, 0.0);
     for &r in &RATIOS {
@@ -247,7 +244,7 @@ fn judge(l: &BenchmarkLoop) -> Row {
             for (c, v) in centred.iter_mut().zip(&valve) {
                 *c = v - mop;
             }
-            let v = filter.ll(&centred).0 - l0;
+            let v = filter.ll(&centred) - l0;
             if v > best.0 {
                 best = (v, b, r);
             }
