@@ -123,6 +123,16 @@ fn a_loop_just_past_its_limit_still_needs_the_valves_lag() {
 /// The cycle of issue 14's example as the family measures it (Kc at 0.996 of the ultimate gain,
 /// a Stenman band of 2 %): the identified loop is at its limit and needs no valve lag.
 fn marginal(scatter: f64, change: f64, wander: f64, setpoint: bool) -> FamilyEvidence {
+    marginal_over(31, scatter, change, wander, setpoint)
+}
+
+fn marginal_over(
+    cycles: usize,
+    scatter: f64,
+    change: f64,
+    wander: f64,
+    setpoint: bool,
+) -> FamilyEvidence {
     let mut e: LoopEvidence = serde_json::from_str(SHORT_CYCLE).unwrap();
     e.needed_gain = 0.98;
     e.needed_lag_degrees = 5.0;
@@ -132,7 +142,7 @@ fn marginal(scatter: f64, change: f64, wander: f64, setpoint: bool) -> FamilyEvi
     e.residual_share = 0.01;
     e.setpoint_recorded = setpoint;
     e.amplitude = Some(AmplitudeTrend {
-        cycles: 31,
+        cycles,
         mean: 10.0,
         change,
         scatter,
@@ -172,4 +182,17 @@ fn a_steady_cycle_whose_phase_runs_free_sustains_itself() {
         "{}",
         blind.note
     );
+}
+
+#[test]
+fn a_long_record_lets_a_steady_amplitude_scatter_more() {
+    // scatter 0.2: steady over 30 cycles or more (noise cannot bring a driven resonance's
+    // scatter this low over so many), not over fewer
+    let long = marginal_over(STEADY_CYCLES, 0.2, 0.1, 5.0, true);
+    assert_eq!(long.vote, Vote::Stiction, "{}", long.note);
+    let short = marginal_over(STEADY_CYCLES - 1, 0.2, 0.1, 5.0, true);
+    assert_eq!(short.vote, Vote::Undetermined, "{}", short.note);
+    // the Rayleigh-like scatter of a noise-driven resonance is never steady
+    let swelling = marginal_over(200, 0.5, 0.1, 5.0, true);
+    assert_eq!(swelling.vote, Vote::Undetermined, "{}", swelling.note);
 }

@@ -3,7 +3,8 @@
 use super::{
     LoopEvidence, StictionBasis, FREE_RUNNING, FULL_LAG, LIMIT_CYCLES, LINEAR_GAIN, LINEAR_LAG,
     MAX_CONTROLLER_RESIDUAL, MAX_DISTANCE, MAX_LAG, MAX_RESIDUAL, MIN_LAG, MIN_MARGIN, NO_SETPOINT,
-    SELF_SUSTAINED, STEADY_SCATTER, UNSTEADY_CHANGE, UNSTEADY_SCATTER,
+    SELF_SUSTAINED, STEADY_CYCLES, STEADY_SCATTER, STEADY_SCATTER_LONG, UNSTEADY_CHANGE,
+    UNSTEADY_SCATTER,
 };
 use crate::diagnose::evidence::{Family, FamilyEvidence};
 use crate::diagnose::result::Vote;
@@ -128,7 +129,12 @@ fn valve_lag_ballot(e: &LoopEvidence) -> Ballot {
 fn self_sustained(e: &LoopEvidence) -> Option<f64> {
     let a = e.amplitude.as_ref()?;
     let w = e.phase_wander?;
-    (a.scatter < STEADY_SCATTER
+    let steady = if a.cycles >= STEADY_CYCLES {
+        STEADY_SCATTER_LONG
+    } else {
+        STEADY_SCATTER
+    };
+    (a.scatter < steady
         && a.change.abs() < UNSTEADY_CHANGE
         && w > FREE_RUNNING
         && e.residual_share <= MAX_RESIDUAL)
