@@ -19,8 +19,10 @@ pub struct Pair {
     tracked: bool,
 }
 
-/// With the load's path known, with a drift's model only, with the process identified too.
-pub type Hidden = [Option<Pair>; 3];
+/// With the load's path known, with a drift's model only, with the process identified too; and
+/// with a drift's model only under processes a little off the truth (how much of the identified
+/// process's loss a better identification could win back).
+pub type Hidden = [Option<Pair>; 6];
 
 /// The share of records at which a filter may have lost track before its estimate is set aside.
 const TRACKED: f64 = 0.01;
@@ -48,43 +50,9 @@ pub fn hidden(l: &BenchmarkLoop, twin_setup: &ClosedLoop, particles: usize) -> O
             tracked: kept && twin_kept,
         })
     };
-    // the process as the closed-loop fit identifies it from each record, the actuator
-    // lag left to it, the noise raised to the fit's misfit
-    let identified = |setup: &ClosedLoop, op: &[f64], pv: &[f64]| {
-        let f = compare_fits(
-            op,
-            pv,
-            &CompareRequest {
-                ts: setup.ts,
-                integrating: Some(l.integrating),
-                ..CompareRequest::default()
-            },
-        )?;
-        let k = f.gain?;
-        let mut s = setup.clone();
-        s.process = if l.integrating {
-            Process::Integrating {
-                k,
-                delay: f.dead_time,
-            }
-        } else {
-            Process::Foptd {
-                k,
-                tau: f.time_constant.unwrap_or(0.0).max(0.1),
-                delay: f.dead_time,
-            }
-        };
-        s.valve_lag = 0.0;
-        // the model's error counted as noise: the fit's simulation error on the changes
-        // over its lag holds two samples' noise
-        let misfit =
-            (f.linear.sse.min(f.stenman.sse) / (2.0 * f.samples_used.max(1) as f64)).sqrt();
-        s.noise = s.noise.max(misfit);
-        Some(s)
-    };
     let fitted = || -> Option<Pair> {
-        let s1 = identified(&l.setup, &l.data.op, &l.data.pv)?;
-        let s0 = identified(twin_setup, &twin_data.op, &twin_data.pv)?;
+        let s1 = identified(l, &l.setup, &l.data.op, &l.data.pv)?;
+        let s0 = identified(l, twin_setup, &twin_data.op, &twin_data.pv)?;
         let (sticky, kept) = llr(&s1, &l.data.op, &l.data.pv, true, false)?;
         let (twin, twin_kept) = llr(&s0, &twin_data.op, &twin_data.pv, false, false)?;
         Some(Pair {
@@ -93,7 +61,113 @@ pub fn hidden(l: &BenchmarkLoop, twin_setup: &ClosedLoop, particles: usize) -> O
             tracked: kept && twin_kept,
         })
     };
-    Some([pair(true), pair(false), fitted()])
+    // the true process a little off, as an identification could leave it
+    let off = |change: Change| -> Option<Pair> {
+        let (mut s1, mut s0) = (l.setup.clone(), twin_setup.clone());
+        change(&mut s1);
+        change(&mut s0);
+        let (sticky, kept) = llr(&s1, &l.data.op, &l.data.pv, true, false)?;
+        let (twin, twin_kept) = llr(&s0, &twin_data.op, &twin_data.pv, false, false)?;
+        Some(Pair {
+            sticky,
+            twin,
+            tracked: kept && twin_kept,
+        })
+    };
+    Some([
+        pair(true),
+        pair(false),
+        fitted(),
+        off(OFF[0].1),
+        off(OFF[1].1),
+        off(OFF[2].1),
+    ])
+}
+
+/// The loop `setup` (of the catalogue's loop `l`) with its process as the closed-loop fit
+/// identifies it from the record `op`, `pv` (first order with dead time, or integrating), the
+/// actuator lag left to it, and the noise raised to the fit's misfit.
+pub fn identified(
+    l: &BenchmarkLoop,
+    setup: &ClosedLoop,
+    op: &[f64],
+    pv: &[f64],
+) -> Option<ClosedLoop> {
+    let f = compare_fits(
+        op,
+        pv,
+        &CompareRequest {
+            ts: setup.ts,
+            integrating: Some(l.integrating),
+            ..CompareRequest::default()
+        },
+    )?;
+    let k = f.gain?;
+    let mut s = setup.clone();
+    s.process = if l.integrating {
+        Process::Integrating {
+            k,
+            delay: f.dead_time,
+        }
+    } else {
+        Process::Foptd {
+            k,
+            tau: f.time_constant.unwrap_or(0.0).max(0.1),
+            delay: f.dead_time,
+        }
+    };
+    s.valve_lag = 0.0;
+    // the model's error counted as noise: the fit's simulation error on the changes over its
+    // lag holds two samples' noise
+    let misfit = (f.linear.sse.min(f.stenman.sse) / (2.0 * f.samples_used.max(1) as f64)).sqrt();
+    s.noise = s.noise.max(misfit);
+    Some(s)
+}
+
+/// A change made to a loop's setup.
+pub type Change = fn(&mut ClosedLoop);
+
+/// The ways of knowing the process a little wrong, as an identification could leave it.
+pub const OFF: [(&str, Change); 3] = [
+    ("the actuator lag left out", |s| s.valve_lag = 0.0),
+    (
+        "the process's gain 10 % high, time constant and dead time 20 % long",
+        |s| s.process = scaled(&s.process, 1.1, 1.2),
+    ),
+    (
+        "the process's gain 10 % low, time constant and dead time 20 % short",
+        |s| s.process = scaled(&s.process, 0.9, 0.8),
+    ),
+];
+
+/// The process with its gain times `k` and its time constant and dead time times `t`.
+pub fn scaled(p: &Process, k: f64, t: f64) -> Process {
+    match *p {
+        Process::Foptd {
+            k: gain,
+            tau,
+            delay,
+        } => Process::Foptd {
+            k: gain * k,
+            tau: tau * t,
+            delay: delay * t,
+        },
+        Process::Integrating { k: gain, delay } => Process::Integrating {
+            k: gain * k,
+            delay: delay * t,
+        },
+        Process::Soptd {
+            k: gain,
+            tau1,
+            tau2,
+            delay,
+        } => Process::Soptd {
+            k: gain * k,
+            tau1: tau1 * t,
+            tau2: tau2 * t,
+            delay: delay * t,
+        },
+    }
 }
 
 /// The oracle's table: each way of knowing the load, over all loops and over those whose filter
@@ -120,7 +194,9 @@ pub fn hidden_table(md: &mut String, rows: &[Row], particles: usize) {
         "its model known (a drift's level and slope in each particle)",
         "its model known, the process as the closed-loop fit identifies it (the noise raised to the fit's misfit)",
     ]
-    .iter()
+    .into_iter()
+    .map(String::from)
+    .chain(OFF.iter().map(|(w, _)| format!("its model known, {w}")))
     .enumerate()
     {
         let every: Vec<Pair> = all.iter().filter_map(|h| h[i]).collect();

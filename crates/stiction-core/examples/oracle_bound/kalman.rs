@@ -36,7 +36,7 @@ pub fn full_run(setup: &ClosedLoop) -> FullRun {
 }
 
 /// PV without load and noise if `model` were the valve, driven by the run's OP.
-fn replay(setup: &ClosedLoop, model: &Model, run: &FullRun) -> Vec<f64> {
+pub(super) fn replay(setup: &ClosedLoop, model: &Model, run: &FullRun) -> Vec<f64> {
     let n = run.op.len();
     let dist = setup
         .disturbance
@@ -65,7 +65,7 @@ fn replay(setup: &ClosedLoop, model: &Model, run: &FullRun) -> Vec<f64> {
 }
 
 /// The process's response to `u` (from rest).
-fn response(p: &Process, dt: f64, u: &[f64]) -> Vec<f64> {
+pub(super) fn response(p: &Process, dt: f64, u: &[f64]) -> Vec<f64> {
     let mut s = p.discretise(dt);
     u.iter()
         .map(|&x| {
@@ -76,19 +76,19 @@ fn response(p: &Process, dt: f64, u: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-const NS: usize = 4;
-type Mat = [[f64; NS]; NS];
+pub(super) const NS: usize = 4;
+pub(super) type Mat = [[f64; NS]; NS];
 
 /// The linear model of the load's effect on PV: state `[x1, x2, level, slope]` (the process's
 /// states, the load's level and slope), `x' = A x + w` with `w` on the slope only, PV's share
 /// `c x`.
-struct LoadStateSpace {
-    a: Mat,
-    c: [f64; NS],
-    q: f64,
+pub(super) struct LoadStateSpace {
+    pub a: Mat,
+    pub c: [f64; NS],
+    pub q: f64,
 }
 
-fn state_space(p: &Process, dt: f64, kick: f64) -> LoadStateSpace {
+pub(super) fn state_space(p: &Process, dt: f64, kick: f64) -> LoadStateSpace {
     let mut a = [[0.0; NS]; NS];
     let mut c = [0.0; NS];
     // process input u = level (the load is not delayed)

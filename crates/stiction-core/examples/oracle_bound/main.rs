@@ -30,10 +30,17 @@
 //! `--band-unknown N` adds, for the Stenman loops and their twins, the same oracles without the
 //! band: the likelihood of a Stenman valve averaged over N bands log-uniform in the suite's range
 //! (0.5-5 % of span), against a healthy valve. With the prior right, that is the best test of all
-//! that do not know the band. Beside it, one oracle that sees OP too only at the recorded samples
+//! that do not know the band. Beside them, the oracles that know less (the table's text says
+//! each): the process identified, profiled or searched under each hypothesis, or a fixed amount
+//! wrong; OP too seen only at the recorded samples (held, or a straight line between them).
+//!
+//! `--particles N` adds, for the Stenman loops of 10 s, the hidden-valve oracle: a particle
+//! filter of N particles over the whole loop between the records (`particles.rs`, `hidden.rs`).
+
 mod hidden;
 mod kalman;
 mod particles;
+mod profile;
 #[path = "../common/study_args.rs"]
 mod study_args;
 mod unknown;
@@ -44,7 +51,7 @@ use std::fmt::Write as _;
 use stiction_core::models::{He, Kano, Model, Stenman};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, LoopClass, Suite, Truth};
 use study_args::StudyArgs;
-use unknown::{band_unknown, held, unknown_table, Unknown};
+use unknown::{less_known, unknown_table, Unknown};
 
 /// A sticky valve from the suite's ranges, for a healthy loop's sticky hypothesis.
 fn drawn_valve(seed: u64) -> Model {
@@ -98,21 +105,8 @@ fn judge(l: &BenchmarkLoop, bands: usize, particles: usize) -> Row {
     twin_setup.model = Model::Stenman(Stenman { d: 0.0 });
     let twin_run = full_run(&twin_setup);
     let twin = llrs(&twin_setup, &l.setup.model, &twin_run);
-    let unknown = (bands > 0 && l.class == LoopClass::StenmanValve).then(|| {
-        let (hs, ht) = (held(&run), held(&twin_run));
-        Unknown {
-            sticky: band_unknown(&l.setup, &run, bands),
-            twin: band_unknown(&twin_setup, &twin_run, bands),
-            held_known: (
-                llrs(&l.setup, &l.setup.model, &hs).recorded,
-                llrs(&twin_setup, &l.setup.model, &ht).recorded,
-            ),
-            held: (
-                band_unknown(&l.setup, &hs, bands).recorded,
-                band_unknown(&twin_setup, &ht, bands).recorded,
-            ),
-        }
-    });
+    let unknown = (bands > 0 && l.class == LoopClass::StenmanValve)
+        .then(|| less_known(l, &twin_setup, &run, &twin_run, bands));
     let hidden = (particles > 0 && l.class == LoopClass::StenmanValve && l.setup.ts >= 5.0)
         .then(|| hidden::hidden(l, &twin_setup, particles))
         .flatten();
