@@ -50,29 +50,28 @@ pub fn hidden(l: &BenchmarkLoop, twin_setup: &ClosedLoop, particles: usize) -> O
             tracked: kept && twin_kept,
         })
     };
-    let fitted = || -> Option<Pair> {
-        let s1 = identified(l, &l.setup, &l.data.op, &l.data.pv)?;
-        let s0 = identified(l, twin_setup, &twin_data.op, &twin_data.pv)?;
-        let (sticky, kept) = llr(&s1, &l.data.op, &l.data.pv, true, false)?;
-        let (twin, twin_kept) = llr(&s0, &twin_data.op, &twin_data.pv, false, false)?;
+    // the sticky loop and its twin under loops `s1`, `s0` other than their own, a drift's model
+    // only
+    let under = |s1: &ClosedLoop, s0: &ClosedLoop| -> Option<Pair> {
+        let (sticky, kept) = llr(s1, &l.data.op, &l.data.pv, true, false)?;
+        let (twin, twin_kept) = llr(s0, &twin_data.op, &twin_data.pv, false, false)?;
         Some(Pair {
             sticky,
             twin,
             tracked: kept && twin_kept,
         })
     };
+    let fitted = || -> Option<Pair> {
+        let s1 = identified(l, &l.setup, &l.data.op, &l.data.pv)?;
+        let s0 = identified(l, twin_setup, &twin_data.op, &twin_data.pv)?;
+        under(&s1, &s0)
+    };
     // the true process a little off, as an identification could leave it
     let off = |change: Change| -> Option<Pair> {
         let (mut s1, mut s0) = (l.setup.clone(), twin_setup.clone());
         change(&mut s1);
         change(&mut s0);
-        let (sticky, kept) = llr(&s1, &l.data.op, &l.data.pv, true, false)?;
-        let (twin, twin_kept) = llr(&s0, &twin_data.op, &twin_data.pv, false, false)?;
-        Some(Pair {
-            sticky,
-            twin,
-            tracked: kept && twin_kept,
-        })
+        under(&s1, &s0)
     };
     Some([
         pair(true),

@@ -17,6 +17,20 @@ pub struct FullRun {
     pub m: usize,
 }
 
+impl FullRun {
+    /// The same run with OP replaced (as a method that sees less of it would have it).
+    pub fn with_op(&self, op: Vec<f64>) -> FullRun {
+        FullRun {
+            op,
+            pv: self.pv.clone(),
+            warm: self.warm,
+            recorded: self.recorded.clone(),
+            dt: self.dt,
+            m: self.m,
+        }
+    }
+}
+
 pub fn full_run(setup: &ClosedLoop) -> FullRun {
     let plan = Plan::new(setup);
     let mut full = setup.clone();

@@ -72,25 +72,43 @@ pub fn recorded_log_likelihood(setup: &ClosedLoop, model: &Model, run: &FullRun)
 
 /// Multipliers of the process's gain, time constants and dead time the profile searches.
 const PROFILE: [f64; 7] = [0.7, 0.8, 0.9, 1.0, 1.1, 1.25, 1.4];
+/// A wide profile: 0.25 to 4 times the truth, geometric.
+pub const WIDE: [f64; 9] = [0.25, 0.35, 0.5, 0.71, 1.0, 1.41, 2.0, 2.83, 4.0];
+/// The narrow profile, for callers.
+pub const NARROW: [f64; 7] = PROFILE;
 
 /// The generalised likelihood ratio of `sticky` against a healthy valve with the process free
 /// under each hypothesis: each hypothesis's log-likelihood maximised over the process's gain, time
 /// constants (together) and dead time, each from 0.7 to 1.4 times the truth.
-pub fn profiled_llr(setup: &ClosedLoop, sticky: &Model, run: &FullRun) -> f64 {
-    let best = |model: &Model| -> f64 {
-        let mut top = f64::NEG_INFINITY;
-        for &k in &PROFILE {
-            for &t in &PROFILE {
-                for &d in &PROFILE {
-                    let mut s = setup.clone();
-                    s.process = rescaled(&setup.process, k, t, d);
-                    top = top.max(recorded_log_likelihood(&s, model, run));
+pub fn profiled_llr(setup: &ClosedLoop, sticky: &Model, run: &FullRun, grid: &[f64]) -> f64 {
+    profile(setup, &[*sticky], run, grid) - profile(setup, &[HEALTHY], run, grid)
+}
+
+/// [`profiled_llr`] with the band free too: the sticky hypothesis's likelihood maximised over
+/// Stenman valves of 16 bands (`band_grid`) as well as the process. A generalised likelihood
+/// ratio over the whole grid: no search, so no local optimum.
+pub fn profiled_band_free_llr(setup: &ClosedLoop, run: &FullRun, grid: &[f64]) -> f64 {
+    let valves: Vec<Model> = band_grid().map(|d| Model::Stenman(Stenman { d })).collect();
+    profile(setup, &valves, run, grid) - profile(setup, &[HEALTHY], run, grid)
+}
+
+const HEALTHY: Model = Model::Stenman(Stenman { d: 0.0 });
+
+/// The greatest log-likelihood over the valves and the grid of process multipliers.
+fn profile(setup: &ClosedLoop, valves: &[Model], run: &FullRun, grid: &[f64]) -> f64 {
+    let mut top = f64::NEG_INFINITY;
+    for &k in grid {
+        for &t in grid {
+            for &d in grid {
+                let mut s = setup.clone();
+                s.process = rescaled(&setup.process, k, t, d);
+                for valve in valves {
+                    top = top.max(recorded_log_likelihood(&s, valve, run));
                 }
             }
         }
-        top
-    };
-    best(sticky) - best(&Model::Stenman(Stenman { d: 0.0 }))
+    }
+    top
 }
 
 /// The process with its gain times `k`, time constants times `t` and dead time times `d`.

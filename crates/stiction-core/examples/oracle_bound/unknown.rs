@@ -48,9 +48,13 @@ pub struct Unknown {
     /// The same with the process as the closed-loop fit identifies it (`hidden::identified`),
     /// band known and unknown: (sticky loop, twin) each.
     pub identified: Option<((f64, f64), (f64, f64))>,
-    /// The same with the process profiled under each hypothesis (`kalman::profiled_llr`), band
+    /// The same with the process profiled under each hypothesis (`profile::profiled_llr`), band
     /// known: (sticky loop, twin).
     pub profiled: (f64, f64),
+    /// The same over a wide grid (`profile::WIDE`, 0.25-4 times the truth).
+    pub profiled_wide: (f64, f64),
+    /// The wide profile with the band free too (`profile::profiled_band_free_llr`).
+    pub profiled_band_free: (f64, f64),
     /// The coordinate search's ratios (`kalman::searched_llr`): band free; band, noise and drift
     /// free. (Sticky loop, twin) each.
     pub searched: [(f64, f64); 2],
@@ -72,14 +76,7 @@ pub fn held(run: &FullRun) -> FullRun {
             *o = v;
         }
     }
-    FullRun {
-        op,
-        pv: run.pv.clone(),
-        warm: run.warm,
-        recorded: run.recorded.clone(),
-        dt: run.dt,
-        m: run.m,
-    }
+    run.with_op(op)
 }
 
 /// The run with OP as a straight line from one recorded sample to the next (before the first
@@ -98,14 +95,7 @@ pub fn interpolated(run: &FullRun) -> FullRun {
         let v = run.op[last];
         op[last..].iter_mut().for_each(|o| *o = v);
     }
-    FullRun {
-        op,
-        pv: run.pv.clone(),
-        warm: run.warm,
-        recorded: run.recorded.clone(),
-        dt: run.dt,
-        m: run.m,
-    }
+    run.with_op(op)
 }
 
 /// The band-unknown oracles and the oracles that know less, on a Stenman loop `l` (run at full
@@ -153,16 +143,24 @@ pub fn less_known(
             profile::searched_from(twin_setup, &s0, &s0, &l.setup.model, twin_run, free),
         )
     });
+    // the "recorded" oracle's ratios on the sticky loop and its twin under loops `s1`, `s0`
+    // and runs `r1`, `r0`: band known, band unknown
+    let known = |s1: &ClosedLoop, s0: &ClosedLoop, r1: &FullRun, r0: &FullRun| {
+        (
+            llrs(s1, &l.setup.model, r1).recorded,
+            llrs(s0, &l.setup.model, r0).recorded,
+        )
+    };
+    let unknown = |s1: &ClosedLoop, s0: &ClosedLoop, r1: &FullRun, r0: &FullRun| {
+        (
+            band_unknown(s1, r1, bands).recorded,
+            band_unknown(s0, r0, bands).recorded,
+        )
+    };
     let identified = fitted.map(|(s1, s0)| {
         (
-            (
-                llrs(&s1, &l.setup.model, run).recorded,
-                llrs(&s0, &l.setup.model, twin_run).recorded,
-            ),
-            (
-                band_unknown(&s1, run, bands).recorded,
-                band_unknown(&s0, twin_run, bands).recorded,
-            ),
+            known(&s1, &s0, run, twin_run),
+            unknown(&s1, &s0, run, twin_run),
         )
     });
     let (hs, ht) = (held(run), held(twin_run));
@@ -170,27 +168,23 @@ pub fn less_known(
     Unknown {
         sticky: band_unknown(&l.setup, run, bands),
         twin: band_unknown(twin_setup, twin_run, bands),
-        held_known: (
-            llrs(&l.setup, &l.setup.model, &hs).recorded,
-            llrs(twin_setup, &l.setup.model, &ht).recorded,
-        ),
-        held: (
-            band_unknown(&l.setup, &hs, bands).recorded,
-            band_unknown(twin_setup, &ht, bands).recorded,
-        ),
-        interpolated_known: (
-            llrs(&l.setup, &l.setup.model, &is).recorded,
-            llrs(twin_setup, &l.setup.model, &it).recorded,
-        ),
-        interpolated: (
-            band_unknown(&l.setup, &is, bands).recorded,
-            band_unknown(twin_setup, &it, bands).recorded,
-        ),
+        held_known: known(&l.setup, twin_setup, &hs, &ht),
+        held: unknown(&l.setup, twin_setup, &hs, &ht),
+        interpolated_known: known(&l.setup, twin_setup, &is, &it),
+        interpolated: unknown(&l.setup, twin_setup, &is, &it),
         identified,
         searched_identified,
         profiled: (
-            profile::profiled_llr(&l.setup, &l.setup.model, run),
-            profile::profiled_llr(twin_setup, &l.setup.model, twin_run),
+            profile::profiled_llr(&l.setup, &l.setup.model, run, &profile::NARROW),
+            profile::profiled_llr(twin_setup, &l.setup.model, twin_run, &profile::NARROW),
+        ),
+        profiled_band_free: (
+            profile::profiled_band_free_llr(&l.setup, run, &profile::WIDE),
+            profile::profiled_band_free_llr(twin_setup, twin_run, &profile::WIDE),
+        ),
+        profiled_wide: (
+            profile::profiled_llr(&l.setup, &l.setup.model, run, &profile::WIDE),
+            profile::profiled_llr(twin_setup, &l.setup.model, twin_run, &profile::WIDE),
         ),
         searched: [false, true].map(|noise_and_drift| {
             let free = profile::Free {
@@ -221,7 +215,8 @@ pub fn unknown_table(md: &mut String, rows: &[Row], bands: usize) {
          Below the three oracles, for each set of records, rows that know less. First the process: as the closed-loop fit identifies it \
          (`compare_fits`' gain, time constant and dead time as a first-order process, the actuator lag left to it, the noise raised to the fit's misfit); \
          profiled under each hypothesis (each hypothesis's likelihood maximised over a grid of the process's gain, time constants and dead time, \
-         0.7 to 1.4 times the truth: a likelihood-ratio test with the process free); searched by coordinate ascent with the band free too \
+         0.7 to 1.4 or 0.25 to 4 times the truth: a likelihood-ratio test with the process free; on the wide grid also with the band free, \
+         every one of 16 bands tried at every point, so no search can stop short); searched by coordinate ascent with the band free too \
          (16 bands log-uniform in 0.5-5 % of span; the ratio is then a generalised likelihood ratio held to 1, not a calibrated test), and the noise and the drift's \
          intensity too; and the same search started from the process the closed-loop fit identifies (time constant at least a sample, dead time at least \
          0.25 s, the noise as `detect::measurement_noise` reads it from the record; 5 sweeps of steps 0.25-4 times). Then the process a fixed amount wrong, \
@@ -273,17 +268,27 @@ pub fn unknown_table(md: &mut String, rows: &[Row], bands: usize) {
             .filter(|r| fine.is_none_or(|f| r.fine == f))
             .filter_map(|r| r.unknown.as_ref())
             .collect();
-        let (ph, pt) = (
-            share(part.iter().map(|u| u.profiled.0 > 0.0)),
-            share(part.iter().map(|u| u.profiled.1 <= 0.0)),
-        );
-        let _ = writeln!(
-            md,
-            "| load's model known, PV at the recorded samples, the process profiled under each hypothesis (gain, time constants and dead time 0.7-1.4 times the truth) | {words} | {} | - | {} | - | {:.3} | - |",
-            pct(ph),
-            pct(pt),
-            balanced(ph, pt)
-        );
+        let pairs = |f: fn(&Unknown) -> (f64, f64)| -> Vec<(f64, f64)> {
+            part.iter().map(|u| f(u)).collect()
+        };
+        let prefix = "load's model known, PV at the recorded samples,";
+        for (profiled, range) in [
+            (
+                (|u| u.profiled) as fn(&Unknown) -> (f64, f64),
+                "gain, time constants and dead time 0.7-1.4 times the truth",
+            ),
+            (
+                |u| u.profiled_wide,
+                "gain, time constants and dead time 0.25-4 times the truth",
+            ),
+            (
+                |u| u.profiled_band_free,
+                "the same, and the band over 16 bands in 0.5-5 % of span: a likelihood ratio held to 1, not calibrated",
+            ),
+        ] {
+            let name = format!("{prefix} the process profiled under each hypothesis ({range})");
+            row(md, &name, words, Some(&pairs(profiled)), None);
+        }
         for (i, what) in [
             "the process and the band searched under each hypothesis (coordinate ascent from the true process)",
             "the process, band, noise and drift's intensity searched (the same)",
@@ -291,85 +296,82 @@ pub fn unknown_table(md: &mut String, rows: &[Row], bands: usize) {
         .iter()
         .enumerate()
         {
-            let h = share(part.iter().map(|u| u.searched[i].0 > 0.0));
-            let t = share(part.iter().map(|u| u.searched[i].1 <= 0.0));
-            let _ = writeln!(
-                md,
-                "| load's model known, PV at the recorded samples, {what} | {words} | - | {} | - | {} | - | {:.3} |",
-                pct(h),
-                pct(t),
-                balanced(h, t)
-            );
+            let searched: Vec<(f64, f64)> = part.iter().map(|u| u.searched[i]).collect();
+            row(md, &format!("{prefix} {what}"), words, None, Some(&searched));
         }
         let from_fit: Vec<(f64, f64)> = part.iter().filter_map(|u| u.searched_identified).collect();
-        let (h, t) = (
-            share(from_fit.iter().map(|u| u.0 > 0.0)),
-            share(from_fit.iter().map(|u| u.1 <= 0.0)),
+        let name = format!(
+            "{prefix} the process, band, noise and drift's intensity searched from the process the closed-loop fit identifies (5 sweeps, steps 0.25-4)"
         );
-        let _ = writeln!(
-            md,
-            "| load's model known, PV at the recorded samples, the process, band, noise and drift's intensity searched from the process the closed-loop fit identifies (5 sweeps, steps 0.25-4) | {words} | - | {} | - | {} | - | {:.3} |",
-            pct(h),
-            pct(t),
-            balanced(h, t)
-        );
+        row(md, &name, words, None, Some(&from_fit));
         for (i, (words_off, _)) in OFF.iter().enumerate() {
-            let h = share(part.iter().map(|u| u.off[i].0 > 0.0));
-            let t = share(part.iter().map(|u| u.off[i].1 <= 0.0));
-            let _ = writeln!(
+            let off: Vec<(f64, f64)> = part.iter().map(|u| u.off[i]).collect();
+            row(
                 md,
-                "| load's model known, PV at the recorded samples, {words_off} | {words} | {} | - | {} | - | {:.3} | - |",
-                pct(h),
-                pct(t),
-                balanced(h, t)
+                &format!("{prefix} {words_off}"),
+                words,
+                Some(&off),
+                None,
             );
         }
-        let with_fit: Vec<((f64, f64), (f64, f64))> =
-            part.iter().filter_map(|u| u.identified).collect();
-        let (kh, kt) = (
-            share(with_fit.iter().map(|(k, _)| k.0 > 0.0)),
-            share(with_fit.iter().map(|(k, _)| k.1 <= 0.0)),
+        let (fit_known, fit_unknown): (Pairs, Pairs) =
+            part.iter().filter_map(|u| u.identified).unzip();
+        let name = format!(
+            "{prefix} the process as the closed-loop fit identifies it (the noise raised to its misfit)"
         );
-        let (h, t) = (
-            share(with_fit.iter().map(|(_, u)| u.0 > 0.0)),
-            share(with_fit.iter().map(|(_, u)| u.1 <= 0.0)),
-        );
-        let _ = writeln!(
+        row(md, &name, words, Some(&fit_known), Some(&fit_unknown));
+        let name = "load's model known, OP and PV at the recorded samples (OP held between them)";
+        row(
             md,
-            "| load's model known, PV at the recorded samples, the process as the closed-loop fit identifies it (the noise raised to its misfit) | {words} | {} | {} | {} | {} | {:.3} | {:.3} |",
-            pct(kh),
-            pct(h),
-            pct(kt),
-            pct(t),
-            balanced(kh, kt),
-            balanced(h, t)
+            name,
+            words,
+            Some(&pairs(|u| u.held_known)),
+            Some(&pairs(|u| u.held)),
         );
-        for (name, known, unknown) in [
-            (
-                "load's model known, OP and PV at the recorded samples (OP held between them)",
-                (|u| u.held_known) as fn(&Unknown) -> (f64, f64),
-                (|u| u.held) as fn(&Unknown) -> (f64, f64),
-            ),
-            (
-                "the same, OP a straight line between the recorded samples",
-                |u| u.interpolated_known,
-                |u| u.interpolated,
-            ),
-        ] {
-            let kh = share(part.iter().map(|u| known(u).0 > 0.0));
-            let kt = share(part.iter().map(|u| known(u).1 <= 0.0));
-            let h = share(part.iter().map(|u| unknown(u).0 > 0.0));
-            let t = share(part.iter().map(|u| unknown(u).1 <= 0.0));
-            let _ = writeln!(
-                md,
-                "| {name} | {words} | {} | {} | {} | {} | {:.3} | {:.3} |",
-                pct(kh),
-                pct(h),
-                pct(kt),
-                pct(t),
-                balanced(kh, kt),
-                balanced(h, t)
-            );
-        }
+        let name = "the same, OP a straight line between the recorded samples";
+        let interpolated = pairs(|u| u.interpolated);
+        row(
+            md,
+            name,
+            words,
+            Some(&pairs(|u| u.interpolated_known)),
+            Some(&interpolated),
+        );
     }
+}
+
+/// Ratios on sticky loops and their twins.
+type Pairs = Vec<(f64, f64)>;
+
+/// One row of the band-unknown table: the shares of sticky loops called sticky (ratio above 0) and
+/// of twins called healthy, band known and unknown ("-" where the oracle has no such column), and
+/// the balanced accuracies.
+fn row(
+    md: &mut String,
+    name: &str,
+    words: &str,
+    known: Option<&[(f64, f64)]>,
+    unknown: Option<&[(f64, f64)]>,
+) {
+    let shares = |p: &[(f64, f64)]| {
+        (
+            share(p.iter().map(|u| u.0 > 0.0)),
+            share(p.iter().map(|u| u.1 <= 0.0)),
+        )
+    };
+    let (k, u) = (known.map(shares), unknown.map(shares));
+    let cell = |x: Option<(usize, usize)>| x.map_or("-".to_string(), pct);
+    let ba = |x: Option<((usize, usize), (usize, usize))>| {
+        x.map_or("-".to_string(), |(h, t)| format!("{:.3}", balanced(h, t)))
+    };
+    let _ = writeln!(
+        md,
+        "| {name} | {words} | {} | {} | {} | {} | {} | {} |",
+        cell(k.map(|x| x.0)),
+        cell(u.map(|x| x.0)),
+        cell(k.map(|x| x.1)),
+        cell(u.map(|x| x.1)),
+        ba(k),
+        ba(u)
+    );
 }
