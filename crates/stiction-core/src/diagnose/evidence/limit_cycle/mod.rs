@@ -97,8 +97,8 @@ pub const STEADY_SCATTER: f64 = 0.15;
 /// PV's cycle) the look-alikes' scatters start at 0.38 (external oscillation), 0.44 (aggressive
 /// tuning) and, but for 3 loops at 0.08-0.19, 0.26 (near-unstable), while 20 sticky valves that
 /// were not called sticky lie between 0.15 and 0.25. Fast sticky loops called stiction there:
-/// 72.7 to 74.3 %; near-unstable loops called stiction 2.7 to 3.0 % (one loop); the routine suite
-/// unchanged but for one sticky loop more.
+/// 72.7 to 74.3 %; near-unstable loops called stiction 2.7 to 3.0 % (one loop); in the routine
+/// suite 3 sticky loops went from undetermined to stiction, nothing else changed.
 pub const STEADY_SCATTER_LONG: f64 = 0.25;
 /// The cycles over which [`STEADY_SCATTER_LONG`] applies.
 pub const STEADY_CYCLES: usize = 30;
