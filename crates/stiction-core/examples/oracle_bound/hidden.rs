@@ -3,6 +3,7 @@
 //! known, with a drift's model only, and with the process as the closed-loop fit identifies it.
 
 use super::particles::log_likelihood;
+use super::profile::rescaled;
 use super::{balanced, pct, share, Row};
 use std::fmt::Write as _;
 use stiction_core::models::{Model, Stenman};
@@ -131,43 +132,13 @@ pub const OFF: [(&str, Change); 3] = [
     ("the actuator lag left out", |s| s.valve_lag = 0.0),
     (
         "the process's gain 10 % high, time constant and dead time 20 % long",
-        |s| s.process = scaled(&s.process, 1.1, 1.2),
+        |s| s.process = rescaled(&s.process, 1.1, 1.2, 1.2),
     ),
     (
         "the process's gain 10 % low, time constant and dead time 20 % short",
-        |s| s.process = scaled(&s.process, 0.9, 0.8),
+        |s| s.process = rescaled(&s.process, 0.9, 0.8, 0.8),
     ),
 ];
-
-/// The process with its gain times `k` and its time constant and dead time times `t`.
-pub fn scaled(p: &Process, k: f64, t: f64) -> Process {
-    match *p {
-        Process::Foptd {
-            k: gain,
-            tau,
-            delay,
-        } => Process::Foptd {
-            k: gain * k,
-            tau: tau * t,
-            delay: delay * t,
-        },
-        Process::Integrating { k: gain, delay } => Process::Integrating {
-            k: gain * k,
-            delay: delay * t,
-        },
-        Process::Soptd {
-            k: gain,
-            tau1,
-            tau2,
-            delay,
-        } => Process::Soptd {
-            k: gain * k,
-            tau1: tau1 * t,
-            tau2: tau2 * t,
-            delay: delay * t,
-        },
-    }
-}
 
 /// The oracle's table: each way of knowing the load, over all loops and over those whose filter
 /// kept track.

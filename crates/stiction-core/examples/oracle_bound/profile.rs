@@ -71,11 +71,9 @@ pub fn recorded_log_likelihood(setup: &ClosedLoop, model: &Model, run: &FullRun)
 }
 
 /// Multipliers of the process's gain, time constants and dead time the profile searches.
-const PROFILE: [f64; 7] = [0.7, 0.8, 0.9, 1.0, 1.1, 1.25, 1.4];
+pub const NARROW: [f64; 7] = [0.7, 0.8, 0.9, 1.0, 1.1, 1.25, 1.4];
 /// A wide profile: 0.25 to 4 times the truth, geometric.
 pub const WIDE: [f64; 9] = [0.25, 0.35, 0.5, 0.71, 1.0, 1.41, 2.0, 2.83, 4.0];
-/// The narrow profile, for callers.
-pub const NARROW: [f64; 7] = PROFILE;
 
 /// The generalised likelihood ratio of `sticky` against a healthy valve with the process free
 /// under each hypothesis: each hypothesis's log-likelihood maximised over the process's gain, time
@@ -88,7 +86,9 @@ pub fn profiled_llr(setup: &ClosedLoop, sticky: &Model, run: &FullRun, grid: &[f
 /// Stenman valves of 16 bands (`band_grid`) as well as the process. A generalised likelihood
 /// ratio over the whole grid: no search, so no local optimum.
 pub fn profiled_band_free_llr(setup: &ClosedLoop, run: &FullRun, grid: &[f64]) -> f64 {
-    let valves: Vec<Model> = band_grid().map(|d| Model::Stenman(Stenman { d })).collect();
+    let valves: Vec<Model> = band_grid(16)
+        .map(|d| Model::Stenman(Stenman { d }))
+        .collect();
     profile(setup, &valves, run, grid) - profile(setup, &[HEALTHY], run, grid)
 }
 
@@ -112,7 +112,7 @@ fn profile(setup: &ClosedLoop, valves: &[Model], run: &FullRun, grid: &[f64]) ->
 }
 
 /// The process with its gain times `k`, time constants times `t` and dead time times `d`.
-fn rescaled(p: &Process, k: f64, t: f64, d: f64) -> Process {
+pub fn rescaled(p: &Process, k: f64, t: f64, d: f64) -> Process {
     match *p {
         Process::Foptd { k: g, tau, delay } => Process::Foptd {
             k: g * k,
@@ -147,9 +147,9 @@ pub struct Free {
     pub noise_and_drift: bool,
 }
 
-/// Bands a free band is searched over.
-fn band_grid() -> impl Iterator<Item = f64> {
-    (0..16).map(|i| (0.5f64.ln() + (i as f64 + 0.5) / 16.0 * 10f64.ln()).exp())
+/// `n` bands log-uniform in the suite's range, 0.5-5 % of span (the middles of equal steps).
+pub fn band_grid(n: usize) -> impl Iterator<Item = f64> {
+    (0..n).map(move |i| (0.5f64.ln() + (i as f64 + 0.5) / n as f64 * 10f64.ln()).exp())
 }
 
 /// The generalised likelihood ratio of a sticky valve against a healthy one, each hypothesis's
@@ -158,31 +158,33 @@ fn band_grid() -> impl Iterator<Item = f64> {
 /// A local search: its optimum is a lower bound on each hypothesis's profile, the same search for
 /// both.
 pub fn searched_llr(setup: &ClosedLoop, sticky: &Model, run: &FullRun, free: Free) -> f64 {
-    searched_from(setup, setup, setup, sticky, run, free)
+    searched_from(setup, sticky, run, free, 3, &NARROW)
 }
 
-/// [`searched_llr`] with each hypothesis's search started from its own loop (`start_sticky`,
-/// `start_healthy`: e.g. the process as a fit identifies it), wider steps and more sweeps.
-pub fn searched_from(
-    truth: &ClosedLoop,
-    start_sticky: &ClosedLoop,
-    start_healthy: &ClosedLoop,
+/// [`searched_llr`] with both hypotheses' searches started from `setup`'s process (e.g. as a fit
+/// identifies it), over wider steps and more sweeps.
+pub fn searched_wide(setup: &ClosedLoop, sticky: &Model, run: &FullRun, free: Free) -> f64 {
+    searched_from(
+        setup,
+        sticky,
+        run,
+        free,
+        5,
+        &[0.25, 0.5, 0.8, 1.0, 1.25, 2.0, 4.0],
+    )
+}
+
+/// The coordinate ascent from `setup`: `sweeps` sweeps, each parameter tried at `steps` times
+/// its value.
+fn searched_from(
+    setup: &ClosedLoop,
     sticky: &Model,
     run: &FullRun,
     free: Free,
+    sweeps: usize,
+    steps: &[f64],
 ) -> f64 {
-    let from_truth = std::ptr::eq(start_sticky, truth) && std::ptr::eq(start_healthy, truth);
-    let (sweeps, steps): (usize, &[f64]) = if from_truth {
-        (3, &PROFILE)
-    } else {
-        (5, &[0.25, 0.5, 0.8, 1.0, 1.25, 2.0, 4.0])
-    };
     let fit = |valve: Option<&Model>| -> f64 {
-        let setup = if valve.is_some() {
-            start_sticky
-        } else {
-            start_healthy
-        };
         // multipliers of gain, time constants, dead time, noise, drift; and the band
         let mut m = [1.0f64; 5];
         let mut band = 1.5;
@@ -194,7 +196,7 @@ pub fn searched_from(
                 *slope_std *= m[4];
             }
             let model = match valve {
-                None => Model::Stenman(Stenman { d: 0.0 }),
+                None => HEALTHY,
                 Some(_) if free.band => Model::Stenman(Stenman { d: band }),
                 Some(v) => *v,
             };
@@ -220,7 +222,7 @@ pub fn searched_from(
                 }
             }
             if valve.is_some() && free.band {
-                for b in band_grid() {
+                for b in band_grid(16) {
                     let v = ll(&m, b);
                     if v > best {
                         (best, band) = (v, b);
@@ -230,6 +232,5 @@ pub fn searched_from(
         }
         best
     };
-    let _ = truth;
     fit(Some(sticky)) - fit(None)
 }

@@ -16,11 +16,8 @@ use stiction_core::sim::Process;
 /// With the prior right, "stiction when the factor exceeds 1" is the test with the smallest sum of
 /// the two errors over sticky loops and twins among all tests that do not know the band.
 pub fn band_unknown(setup: &ClosedLoop, run: &FullRun, bands: usize) -> Llr {
-    let each: Vec<Llr> = (0..bands)
-        .map(|i| {
-            let d = (0.5f64.ln() + (i as f64 + 0.5) / bands as f64 * (10.0f64).ln()).exp();
-            llrs(setup, &Model::Stenman(Stenman { d }), run)
-        })
+    let each: Vec<Llr> = profile::band_grid(bands)
+        .map(|d| llrs(setup, &Model::Stenman(Stenman { d }), run))
         .collect();
     let mean = |pick: Pick| {
         let top = each.iter().map(pick).fold(f64::NEG_INFINITY, f64::max);
@@ -139,8 +136,8 @@ pub fn less_known(
             s.noise = noise.max(1e-3);
         }
         (
-            profile::searched_from(&l.setup, &s1, &s1, &l.setup.model, run, free),
-            profile::searched_from(twin_setup, &s0, &s0, &l.setup.model, twin_run, free),
+            profile::searched_wide(&s1, &l.setup.model, run, free),
+            profile::searched_wide(&s0, &l.setup.model, twin_run, free),
         )
     });
     // the "recorded" oracle's ratios on the sticky loop and its twin under loops `s1`, `s0`
