@@ -49,7 +49,7 @@ use kalman::{full_run, llrs, Llr};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use stiction_core::models::{He, Kano, Model, Stenman};
-use stiction_core::sim::catalogue::{self, BenchmarkLoop, LoopClass, Suite, Truth};
+use stiction_core::sim::catalogue::{self, BenchmarkLoop, LoopClass, LoopKind, Suite, Truth};
 use study_args::StudyArgs;
 use unknown::{less_known, unknown_table, Unknown};
 
@@ -80,6 +80,7 @@ fn drawn_valve(seed: u64) -> Model {
 
 struct Row {
     class: LoopClass,
+    kind: LoopKind,
     fine: bool,
     sticky: Llr,
     twin: Llr,
@@ -113,6 +114,7 @@ fn judge(l: &BenchmarkLoop, bands: usize, particles: usize) -> Row {
     Row {
         hidden,
         class: l.class,
+        kind: l.kind,
         fine: l.setup.ts < 5.0,
         sticky,
         twin,
@@ -250,6 +252,7 @@ fn main() {
     }
     if bands > 0 {
         unknown_table(&mut md, &rows, bands);
+        unknown::by_kind_table(&mut md, &rows);
     }
     if particles > 0 {
         hidden::hidden_table(&mut md, &rows, particles);

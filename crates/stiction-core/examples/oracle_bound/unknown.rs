@@ -6,7 +6,7 @@ use super::profile;
 use super::{balanced, pct, share, Pick, Row, ORACLES};
 use std::fmt::Write as _;
 use stiction_core::models::{Model, Stenman};
-use stiction_core::sim::catalogue::BenchmarkLoop;
+use stiction_core::sim::catalogue::{BenchmarkLoop, LoopKind};
 use stiction_core::sim::ClosedLoop;
 use stiction_core::sim::Process;
 
@@ -57,6 +57,31 @@ pub struct Unknown {
     pub searched: [(f64, f64); 2],
     /// The search with everything free, started from the process the closed-loop fit identifies.
     pub searched_identified: Option<(f64, f64)>,
+    /// The wide profile with the band free, centred on the process the closed-loop fit
+    /// identifies (the noise as the record shows it; the drift's intensity still known).
+    pub profiled_identified: Option<(f64, f64)>,
+    /// The wide profile with the band free around the true process, the noise as the record
+    /// shows it.
+    pub profiled_noise_read: (f64, f64),
+    /// The wide profile with the band free around the fit's process, the true noise.
+    pub profiled_fit_true_noise: Option<(f64, f64)>,
+}
+
+/// The loop a search or profile starts from: the fit's process (`fit`), its time constant at
+/// least a sample (`ts`) and its dead time at least 0.25 s, the noise as
+/// `detect::measurement_noise` reads it from the record's `pv`.
+fn from_fit(fit: &ClosedLoop, pv: &[f64], ts: f64) -> ClosedLoop {
+    let mut s = fit.clone();
+    match &mut s.process {
+        Process::Foptd { tau, delay, .. } => {
+            *tau = tau.max(ts);
+            *delay = delay.max(0.25);
+        }
+        Process::Integrating { delay, .. } => *delay = delay.max(0.25),
+        Process::Soptd { .. } => {}
+    }
+    s.noise = stiction_core::detect::measurement_noise(pv).max(1e-3);
+    s
 }
 
 /// The run with OP as the historian has it: held from one recorded sample to the next (before
@@ -115,30 +140,43 @@ pub fn less_known(
         band: true,
         noise_and_drift: true,
     };
-    let searched_identified = fitted.as_ref().map(|(s1, s0)| {
-        // each record's own fit starts both hypotheses' searches on it
-        let mut s1 = s1.clone();
-        let mut s0 = s0.clone();
-        let noise = [
-            stiction_core::detect::measurement_noise(&l.data.pv),
-            stiction_core::detect::measurement_noise(&twin_data.pv),
-        ];
-        for (s, noise) in [&mut s1, &mut s0].into_iter().zip(noise) {
-            match &mut s.process {
-                Process::Foptd { tau, delay, .. } => {
-                    *tau = tau.max(s.ts);
-                    *delay = delay.max(0.25);
-                }
-                Process::Integrating { delay, .. } => *delay = delay.max(0.25),
-                Process::Soptd { .. } => {}
-            }
-            // the noise as the record shows it
-            s.noise = noise.max(1e-3);
-        }
+    // each record's own fit, the noise as the record shows it
+    let starts = fitted.as_ref().map(|(s1, s0)| {
         (
-            profile::searched_wide(&s1, &l.setup.model, run, free),
-            profile::searched_wide(&s0, &l.setup.model, twin_run, free),
+            from_fit(s1, &l.data.pv, l.setup.ts),
+            from_fit(s0, &twin_data.pv, l.setup.ts),
         )
+    });
+    let searched_identified = starts.as_ref().map(|(s1, s0)| {
+        // each record's own fit starts both hypotheses' searches on it
+        (
+            profile::searched_wide(s1, &l.setup.model, run, free),
+            profile::searched_wide(s0, &l.setup.model, twin_run, free),
+        )
+    });
+    let wide = |s1: &ClosedLoop, s0: &ClosedLoop| {
+        (
+            profile::profiled_band_free_llr(s1, run, &profile::WIDE),
+            profile::profiled_band_free_llr(s0, twin_run, &profile::WIDE),
+        )
+    };
+    let profiled_identified = starts.as_ref().map(|(s1, s0)| wide(s1, s0));
+    // what the drop from the truth's profile to the fit's comes from: the noise as the record
+    // shows it around the true process; the fit's process with the true noise
+    let noise_read = |s: &ClosedLoop, pv: &[f64]| {
+        let mut s = s.clone();
+        s.noise = stiction_core::detect::measurement_noise(pv).max(1e-3);
+        s
+    };
+    let profiled_noise_read = wide(
+        &noise_read(&l.setup, &l.data.pv),
+        &noise_read(twin_setup, &twin_data.pv),
+    );
+    let profiled_fit_true_noise = starts.as_ref().map(|(s1, s0)| {
+        let (mut s1, mut s0) = (s1.clone(), s0.clone());
+        s1.noise = l.setup.noise;
+        s0.noise = twin_setup.noise;
+        wide(&s1, &s0)
     });
     // the "recorded" oracle's ratios on the sticky loop and its twin under loops `s1`, `s0`
     // and runs `r1`, `r0`: band known, band unknown
@@ -171,6 +209,9 @@ pub fn less_known(
         interpolated: unknown(&l.setup, twin_setup, &is, &it),
         identified,
         searched_identified,
+        profiled_identified,
+        profiled_noise_read,
+        profiled_fit_true_noise,
         profiled: (
             profile::profiled_llr(&l.setup, &l.setup.model, run, &profile::NARROW),
             profile::profiled_llr(twin_setup, &l.setup.model, twin_run, &profile::NARROW),
@@ -301,6 +342,29 @@ pub fn unknown_table(md: &mut String, rows: &[Row], bands: usize) {
             "{prefix} the process, band, noise and drift's intensity searched from the process the closed-loop fit identifies (5 sweeps, steps 0.25-4)"
         );
         row(md, &name, words, None, Some(&from_fit));
+        let around_fit: Vec<(f64, f64)> =
+            part.iter().filter_map(|u| u.profiled_identified).collect();
+        let name = format!(
+            "{prefix} the process and the band profiled around the process the closed-loop fit identifies (0.25-4 times it, 16 bands; the noise as the record shows it)"
+        );
+        row(md, &name, words, None, Some(&around_fit));
+        let name =
+            format!("{prefix} the same around the true process, the noise as the record shows it");
+        row(
+            md,
+            &name,
+            words,
+            None,
+            Some(&pairs(|u| u.profiled_noise_read)),
+        );
+        let fit_true_noise: Vec<(f64, f64)> = part
+            .iter()
+            .filter_map(|u| u.profiled_fit_true_noise)
+            .collect();
+        let name = format!(
+            "{prefix} the same around the process the closed-loop fit identifies, the true noise"
+        );
+        row(md, &name, words, None, Some(&fit_true_noise));
         for (i, (words_off, _)) in OFF.iter().enumerate() {
             let off: Vec<(f64, f64)> = part.iter().map(|u| u.off[i]).collect();
             row(
@@ -337,6 +401,54 @@ pub fn unknown_table(md: &mut String, rows: &[Row], bands: usize) {
     }
 }
 
+/// The wide profile with the band free around the true process and around the fit's, by loop
+/// kind: where the fit's process costs the test.
+pub fn by_kind_table(md: &mut String, rows: &[Row]) {
+    let _ = writeln!(
+        md,
+        "\n### The wide profile with the band free, by loop kind (all records)\n\n\
+         Around the true process and around the process the closed-loop fit identifies (a first-order process with dead time, \
+         or an integrator, without the actuator lag; the noise as the record shows it).\n\n\
+         | kind | pairs | around the truth: sticky called stiction | twins called healthy | around the fit's process: sticky called stiction | twins called healthy |\n|---|---|---|---|---|---|"
+    );
+    let mut kinds: Vec<LoopKind> = rows
+        .iter()
+        .filter(|r| r.unknown.is_some())
+        .map(|r| r.kind)
+        .collect();
+    kinds.sort_by_key(|k| k.name());
+    kinds.dedup();
+    for kind in kinds {
+        let part: Vec<&Unknown> = rows
+            .iter()
+            .filter(|r| r.kind == kind)
+            .filter_map(|r| r.unknown.as_ref())
+            .collect();
+        let truth: Pairs = part.iter().map(|u| u.profiled_band_free).collect();
+        let fit: Pairs = part.iter().filter_map(|u| u.profiled_identified).collect();
+        let (ts, tt) = shares(&truth);
+        let (fs, ft) = shares(&fit);
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} |",
+            kind.name(),
+            part.len(),
+            pct(ts),
+            pct(tt),
+            pct(fs),
+            pct(ft)
+        );
+    }
+}
+
+/// The shares of sticky loops called sticky (ratio above 0) and of twins called healthy.
+fn shares(p: &[(f64, f64)]) -> ((usize, usize), (usize, usize)) {
+    (
+        share(p.iter().map(|u| u.0 > 0.0)),
+        share(p.iter().map(|u| u.1 <= 0.0)),
+    )
+}
+
 /// Ratios on sticky loops and their twins.
 type Pairs = Vec<(f64, f64)>;
 
@@ -350,12 +462,6 @@ fn row(
     known: Option<&[(f64, f64)]>,
     unknown: Option<&[(f64, f64)]>,
 ) {
-    let shares = |p: &[(f64, f64)]| {
-        (
-            share(p.iter().map(|u| u.0 > 0.0)),
-            share(p.iter().map(|u| u.1 <= 0.0)),
-        )
-    };
     let (k, u) = (known.map(shares), unknown.map(shares));
     let cell = |x: Option<(usize, usize)>| x.map_or("-".to_string(), pct);
     let ba = |x: Option<((usize, usize), (usize, usize))>| {
