@@ -28,6 +28,7 @@ mod band;
 #[path = "../common/catalogue_loop.rs"]
 mod catalogue_loop;
 mod confidence;
+mod excitation;
 mod spread;
 mod tables;
 use tables::{
@@ -220,6 +221,7 @@ fn run_suite(o: &Options, suite: Suite, md: &mut String, jsonl: &mut String) {
     sticky_table(md, &loops, &res);
     band::band_table(md, &groups);
     confidence::confidence_table(md, &groups);
+    excitation::excitation_table(md, &groups);
     if THOROUGH.load(std::sync::atomic::Ordering::Relaxed) {
         levels_table(md, &groups);
     }
