@@ -85,7 +85,10 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         indices: Default::default(),
     };
     let families: Vec<FamilyEvidence> = evidence::all().iter().map(|f| f.evaluate(&ctx)).collect();
-    let decision = verdict::decide(&families, &verdict::Motion::of(&ctx.oscillation, req.ts));
+    let decision = verdict::decide(
+        &families,
+        &verdict::Motion::of(&ctx.oscillation, req.ts, r.sp),
+    );
     let Context {
         oscillation,
         indices,

@@ -61,6 +61,20 @@ fn weak_evidence_against_stiction_says_so_in_the_next_step() {
     assert_eq!(d.verdict, Verdict::NoStiction);
     assert!(d.next_step.contains("weak"), "{}", d.next_step);
     assert!(d.next_step.contains("valve travel test"), "{}", d.next_step);
+    assert!(!d.next_step.contains("setpoint"), "{}", d.next_step);
+    // a window whose setpoint holds: a window with setpoint changes would say more
+    let steady = Motion {
+        setpoint_steady: true,
+        ..calm()
+    };
+    let d = decide(&[weak(0.25)], &steady);
+    assert!(
+        d.next_step.contains("a window that holds setpoint changes"),
+        "{}",
+        d.next_step
+    );
+    let d = decide(&[weak(0.9)], &steady);
+    assert_eq!(d.next_step, "no action on the valve");
     let d = decide(&[weak(0.9)], &calm());
     assert_eq!(d.verdict, Verdict::NoStiction);
     assert_eq!(d.next_step, "no action on the valve");

@@ -14,6 +14,7 @@ fn oscillating() -> Motion {
     Motion {
         oscillating: true,
         unresolved_cycle: None,
+        setpoint_steady: false,
     }
 }
 
