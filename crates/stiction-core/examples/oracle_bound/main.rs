@@ -44,6 +44,7 @@ mod profile;
 #[path = "../common/study_args.rs"]
 mod study_args;
 mod unknown;
+mod unknown_tables;
 
 use kalman::{full_run, llrs, Llr};
 use rayon::prelude::*;
@@ -51,7 +52,8 @@ use std::fmt::Write as _;
 use stiction_core::models::{He, Kano, Model, Stenman};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, LoopClass, LoopKind, Suite, Truth};
 use study_args::StudyArgs;
-use unknown::{less_known, unknown_table, Unknown};
+use unknown::{less_known, Unknown};
+use unknown_tables::{by_kind_table, unknown_table};
 
 /// A sticky valve from the suite's ranges, for a healthy loop's sticky hypothesis.
 fn drawn_valve(seed: u64) -> Model {
@@ -252,7 +254,7 @@ fn main() {
     }
     if bands > 0 {
         unknown_table(&mut md, &rows, bands);
-        unknown::by_kind_table(&mut md, &rows);
+        by_kind_table(&mut md, &rows);
     }
     if particles > 0 {
         hidden::hidden_table(&mut md, &rows, particles);
