@@ -25,10 +25,10 @@
 //! sticky loops called `stiction`; every look-alike class at least 95 % not called `stiction`.
 
 mod band;
+mod breakdown;
 #[path = "../common/catalogue_loop.rs"]
 mod catalogue_loop;
 mod confidence;
-mod excitation;
 mod spread;
 mod tables;
 use tables::{
@@ -221,7 +221,7 @@ fn run_suite(o: &Options, suite: Suite, md: &mut String, jsonl: &mut String) {
     sticky_table(md, &loops, &res);
     band::band_table(md, &groups);
     confidence::confidence_table(md, &groups);
-    excitation::excitation_table(md, &groups);
+    breakdown::breakdown_tables(md, &groups);
     if THOROUGH.load(std::sync::atomic::Ordering::Relaxed) {
         levels_table(md, &groups);
     }
