@@ -13,11 +13,10 @@
 //! which can only make the ratio smaller. The statistic is twice the log-likelihood ratio,
 //! `n ln(SS_linear / SS_sticky)` over the `n` innovations compared.
 
-use serde::{Deserialize, Serialize};
-use stiction_core::models::{Stenman, StictionModel};
+use stiction_core::models::{Model, Stenman};
 
 /// What the likelihood ratio needs besides OP and PV.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DriftRequest {
     /// Sampling interval, seconds.
     pub ts: f64,
@@ -28,7 +27,7 @@ pub struct DriftRequest {
 }
 
 /// One hypothesis's best fit on the grid.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DriftFit {
     /// Stenman's band, OP units (0: the valve follows OP).
     pub band: f64,
@@ -47,7 +46,7 @@ pub struct DriftFit {
 }
 
 /// The likelihood ratio and the two fits behind it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DriftLikelihood {
     /// Twice the log-likelihood ratio of the sticky hypothesis over the linear one.
     pub statistic: f64,
@@ -72,6 +71,14 @@ const PHIS: [f64; 3] = [0.0, 0.9, 0.99];
 /// Bands tried, % of span: 16 log-uniform from 0.2 to 8.
 fn bands() -> impl Iterator<Item = f64> {
     (0..16).map(|i| (0.2f64.ln() + i as f64 / 15.0 * 40f64.ln()).exp())
+}
+
+/// One noise model and the PV's change and a constant whitened by it.
+struct Whitened {
+    theta: f64,
+    phi: f64,
+    z: Vec<f64>,
+    f: Vec<f64>,
 }
 
 /// A process shape: integrating or not, time constant, lag (seconds).
@@ -186,59 +193,53 @@ pub fn drift_likelihood(op: &[f64], pv: &[f64], req: &DriftRequest) -> Option<Dr
         .chain(pv.windows(2).map(|w| w[1] - w[0]))
         .collect();
     let shapes = shapes(req.ts, n, req.integrating);
-    let (mut dx, mut z, mut w, mut f) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut dx, mut w) = (Vec::new(), Vec::new());
+    // every noise model's whitened PV change `z` and constant `f`, once
     let ones = vec![1.0; n];
-    // the linear hypothesis over every noise model
-    let mut linear: Option<(f64, Shape, usize, f64, f64, f64)> = None;
-    let mut responses = Vec::with_capacity(shapes.len());
-    for &shape in &shapes {
-        response_change(shape, req.ts, op, &mut dx);
-        responses.push(dx.clone());
-    }
-    for &theta in &THETAS {
-        for &phi in &PHIS {
+    let whitened: Vec<Whitened> = THETAS
+        .iter()
+        .flat_map(|&theta| PHIS.iter().map(move |&phi| (theta, phi)))
+        .map(|(theta, phi)| {
+            let (mut z, mut f) = (Vec::new(), Vec::new());
             whiten(&dy, theta, phi, &mut z);
             whiten(&ones, theta, phi, &mut f);
-            for (shape, dx) in shapes.iter().zip(&responses) {
-                whiten(dx, theta, phi, &mut w);
-                let (sse, k, gain) = best_delay(&z, &w, &f, t0, &delays);
-                if linear.is_none_or(|b| sse < b.0) {
-                    linear = Some((sse, *shape, k, gain, theta, phi));
-                }
+            Whitened { theta, phi, z, f }
+        })
+        .collect();
+    // the linear hypothesis over every noise model
+    let mut linear: Option<(f64, Shape, usize, f64, usize)> = None;
+    let responses: Vec<Vec<f64>> = shapes
+        .iter()
+        .map(|&shape| {
+            response_change(shape, req.ts, op, &mut dx);
+            dx.clone()
+        })
+        .collect();
+    for (i, noise) in whitened.iter().enumerate() {
+        for (shape, dx) in shapes.iter().zip(&responses) {
+            whiten(dx, noise.theta, noise.phi, &mut w);
+            let (sse, k, gain) = best_delay(&noise.z, &w, &noise.f, t0, &delays);
+            if linear.is_none_or(|b| sse < b.0) {
+                linear = Some((sse, *shape, k, gain, i));
             }
         }
     }
-    let (sse_lin, shape_lin, k_lin, gain_lin, theta, phi) = linear?;
+    let (sse_lin, shape_lin, k_lin, gain_lin, noise_lin) = linear?;
     // the noise models the sticky hypothesis may take: the linear loop's, or (`full`) every one
-    let models: Vec<(f64, f64)> = if req.full {
-        THETAS
-            .iter()
-            .flat_map(|&t| PHIS.iter().map(move |&p| (t, p)))
-            .collect()
+    let models = if req.full {
+        &whitened[..]
     } else {
-        vec![(theta, phi)]
+        &whitened[noise_lin..=noise_lin]
     };
-    let whitened: Vec<(f64, f64, Vec<f64>, Vec<f64>)> = models
-        .iter()
-        .map(|&(theta, phi)| {
-            whiten(&dy, theta, phi, &mut z);
-            whiten(&ones, theta, phi, &mut f);
-            (theta, phi, z.clone(), f.clone())
-        })
-        .collect();
     let mut sticky = (sse_lin, shape_lin, k_lin, gain_lin, 0.0);
     let mut mv = vec![0.0; n];
     for d in bands() {
-        let valve = Stenman { d };
-        let (mut state, _) = valve.start(op[0]);
-        for (m, &u) in mv.iter_mut().zip(op) {
-            *m = valve.step(&mut state, u);
-        }
+        Model::Stenman(Stenman { d }).simulate_from_into(op, None, &mut mv);
         for &shape in &shapes {
             response_change(shape, req.ts, &mv, &mut dx);
-            for (theta, phi, z, f) in &whitened {
-                whiten(&dx, *theta, *phi, &mut w);
-                let (sse, k, gain) = best_delay(z, &w, f, t0, &delays);
+            for noise in models {
+                whiten(&dx, noise.theta, noise.phi, &mut w);
+                let (sse, k, gain) = best_delay(&noise.z, &w, &noise.f, t0, &delays);
                 if sse < sticky.0 {
                     sticky = (sse, shape, k, gain, d);
                 }
@@ -259,8 +260,8 @@ pub fn drift_likelihood(op: &[f64], pv: &[f64], req: &DriftRequest) -> Option<Dr
         statistic: m as f64 * (sse_lin / sticky.0.max(1e-300)).ln(),
         linear: fit(sse_lin, shape_lin, k_lin, gain_lin, 0.0),
         sticky: fit(sticky.0, sticky.1, sticky.2, sticky.3, sticky.4),
-        theta,
-        phi,
+        theta: whitened[noise_lin].theta,
+        phi: whitened[noise_lin].phi,
         samples: m,
     })
 }

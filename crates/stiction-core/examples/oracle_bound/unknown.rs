@@ -70,7 +70,7 @@ pub struct Unknown {
 /// least a sample (`ts`) and its dead time at least 0.25 s, the noise as
 /// `detect::measurement_noise` reads it from the record's `pv`.
 fn from_fit(fit: &ClosedLoop, pv: &[f64], ts: f64) -> ClosedLoop {
-    let mut s = fit.clone();
+    let mut s = noise_read(fit, pv);
     match &mut s.process {
         Process::Foptd { tau, delay, .. } => {
             *tau = tau.max(ts);
@@ -79,6 +79,12 @@ fn from_fit(fit: &ClosedLoop, pv: &[f64], ts: f64) -> ClosedLoop {
         Process::Integrating { delay, .. } => *delay = delay.max(0.25),
         Process::Soptd { .. } => {}
     }
+    s
+}
+
+/// The loop with the noise as `detect::measurement_noise` reads it from the record's `pv`.
+fn noise_read(s: &ClosedLoop, pv: &[f64]) -> ClosedLoop {
+    let mut s = s.clone();
     s.noise = stiction_core::detect::measurement_noise(pv).max(1e-3);
     s
 }
@@ -247,11 +253,6 @@ fn wide_profiles(
             profile::profiled_band_free_llr(s1, run, &profile::WIDE),
             profile::profiled_band_free_llr(s0, twin_run, &profile::WIDE),
         )
-    };
-    let noise_read = |s: &ClosedLoop, pv: &[f64]| {
-        let mut s = s.clone();
-        s.noise = stiction_core::detect::measurement_noise(pv).max(1e-3);
-        s
     };
     let around_fit = starts.map(|(s1, s0)| wide(s1, s0));
     let noise_read = wide(
