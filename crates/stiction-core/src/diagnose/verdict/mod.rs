@@ -21,7 +21,7 @@ pub(super) struct Decision {
 /// A side of a conflict wins when its total strength is at least this many times the other's and
 /// no single vote against it is stronger than `WEAK_DISSENT`.
 const DOMINANCE: f64 = 1.0;
-const WEAK_DISSENT: f64 = 0.5;
+pub(crate) const WEAK_DISSENT: f64 = 0.5;
 /// A stiction verdict needs at least one vote this strong.
 const DECIDES: f64 = 0.5;
 
@@ -281,8 +281,8 @@ fn leaning_reason(leaning: &[&FamilyEvidence]) -> String {
 
 /// Below this confidence a `no_stiction` rests only on weak votes against (a fit no better than
 /// healthy loops give, no stick-slip episode found), which a sticky valve often gives too: on the
-/// plant benchmark's routine windows such verdicts were right in 147 of 237 loops (62 %), those
-/// at 0.8 or more in 27 of 34 (docs/plant-benchmark.md, "What the confidence means here").
+/// plant benchmark's routine windows such verdicts were right in 147 of 235 loops (63 %), those
+/// at 0.8 or more in 19 of 20 (docs/plant-benchmark.md, "What the confidence means here").
 const WEAK_NO_STICTION: f64 = 0.6;
 
 /// Added to a weak verdict's next step when the setpoint holds over the whole stretch.

@@ -66,8 +66,22 @@ fn limit_cycles(ctx: &Context) -> bool {
     let o = &ctx.oscillation;
     o.oscillating && o.regularity.regularity >= LIMIT_CYCLE_REGULARITY
 }
-/// Strength of a vote against stiction when OP does not drive PV.
+/// Strength of a vote against stiction when OP does not drive PV: OP explains under
+/// [`ELSEWHERE_CLEAR`] of the PV's variation above its noise.
 const ELSEWHERE_STRENGTH: f64 = 0.9;
+/// Below this share explained the variation plainly enters elsewhere; from it up to
+/// [`MIN_EXPLAINED`] a sticky valve that seldom moves in a window driven by its load leaves as
+/// little (levels and temperatures above all), and the vote is weak
+/// ([`ELSEWHERE_WEAK_STRENGTH`]). On the catalogue's calibration sets (routine and fast) 20 of the
+/// 21 loops under 0.15 have a healthy valve, 10 of the 17 between 0.15 and 0.3.
+pub const ELSEWHERE_CLEAR: f64 = 0.15;
+/// Strength of the vote against stiction when OP explains between [`ELSEWHERE_CLEAR`] and
+/// [`MIN_EXPLAINED`]: just over the verdict's weak dissent, so it still keeps a lone vote for
+/// stiction from deciding (every verdict of the plant benchmark stays as it was), while a
+/// `no_stiction` resting on it is no longer given 0.93 (with the stick-slip family's weak vote:
+/// 0.66). Of the `no_stiction` verdicts at 0.8 or more, 81 % were right on the calibration set's
+/// routine windows and 88 % on the benchmark set's; with the vote graded, 95 % on both.
+const ELSEWHERE_WEAK_STRENGTH: f64 = 0.55;
 /// Fewest changes over the lag that do not overlap (samples over the lag) for the test.
 pub const MIN_INDEPENDENT: f64 = 8.0;
 /// Below this share of the PV's variance above its noise the record carries too little signal.
@@ -308,6 +322,16 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
     }
 }
 
+/// The strength of the vote against stiction when OP explains the share `explained` (under
+/// [`MIN_EXPLAINED`]) of the PV's variation above its noise.
+fn elsewhere_strength(explained: f64) -> f64 {
+    if explained < ELSEWHERE_CLEAR {
+        ELSEWHERE_STRENGTH
+    } else {
+        ELSEWHERE_WEAK_STRENGTH
+    }
+}
+
 /// The strength of a stiction vote at the test's ratio `significance` (at least the threshold):
 /// a half at the threshold, full at [`SIGNIFICANCE_DECISIVE`].
 fn test_strength(significance: f64) -> f64 {
@@ -346,7 +370,7 @@ fn vote(ctx: &Context, f: &FitComparison, levels: &Levels) -> (Vote, f64, String
     } else if explained < MIN_EXPLAINED {
         (
             Vote::NoStiction,
-            ELSEWHERE_STRENGTH,
+            elsewhere_strength(explained),
             format!(
                 "OP explains only {:.0} % of the PV's variation above its noise through any valve: the variation enters the loop elsewhere",
                 100.0 * explained.max(0.0)
@@ -390,5 +414,31 @@ fn vote(ctx: &Context, f: &FitComparison, levels: &Levels) -> (Vote, f64, String
                 100.0 * improvement
             ),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Strong only where OP plainly explains nothing; between, strong enough to stand as dissent
+    /// against a lone stiction vote (the verdict's weak dissent is 0.5) but far from decisive.
+    // the weak vote stands as dissent against a lone stiction vote, and is graded below the
+    // share under which the family votes this way at all
+    const _: () = assert!(
+        ELSEWHERE_WEAK_STRENGTH > crate::diagnose::verdict::WEAK_DISSENT
+            && ELSEWHERE_WEAK_STRENGTH < 0.6
+            && ELSEWHERE_CLEAR < MIN_EXPLAINED
+    );
+
+    #[test]
+    fn the_vote_that_the_variation_enters_elsewhere_is_graded() {
+        assert_eq!(elsewhere_strength(0.05), ELSEWHERE_STRENGTH);
+        assert_eq!(
+            elsewhere_strength(ELSEWHERE_CLEAR - 1e-9),
+            ELSEWHERE_STRENGTH
+        );
+        assert_eq!(elsewhere_strength(ELSEWHERE_CLEAR), ELSEWHERE_WEAK_STRENGTH);
+        assert_eq!(elsewhere_strength(0.29), ELSEWHERE_WEAK_STRENGTH);
     }
 }
