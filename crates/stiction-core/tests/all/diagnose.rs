@@ -1,6 +1,6 @@
 //! The diagnosis: usable stretches, the families of evidence, the verdict, windows.
 
-use stiction_core::diagnose::evidence::model::CYCLE_CANCELLED_STICTION;
+use stiction_core::diagnose::evidence::model::{CYCLE_CANCELLED_STICTION, FORCED_REGULARITY};
 use stiction_core::diagnose::{
     diagnose, BandSource, DiagnoseRequest, Family, LoopRecord, Verdict, Vote,
 };
@@ -517,4 +517,43 @@ fn a_band_under_the_ops_noise_is_none_the_fits_resolve_and_the_ellipse_stands_in
         "{:?}",
         d.warnings
     );
+}
+
+#[test]
+fn a_band_that_only_fits_a_clock_regular_cycle_is_no_vote() {
+    // routine-c-0465 of the catalogue's calibration set: a healthy pressure valve whose load
+    // carries a sine (period about 200 s). A band fits the cycle better than a valve that follows
+    // OP (test ratio 96), but the cycle keeps time like an input of fixed period (regularity
+    // 125), and over whole periods, where it cancels, the band gains nothing: no vote.
+    let d = judge_catalogue("routine-c-0465");
+    let model = model_family(&d);
+    let osc = d.oscillation.as_ref().unwrap();
+    assert!(osc.regularity.regularity >= FORCED_REGULARITY, "{osc:?}");
+    let m = model.model.as_ref().unwrap();
+    assert!(m.significance >= 50.0, "{}", model.note);
+    assert!(
+        m.cycle_cancelled.as_ref().unwrap().significance <= 15.0,
+        "{}",
+        model.note
+    );
+    assert_eq!(model.vote, Vote::Undetermined, "{}", model.note);
+    assert_eq!(model.leans, Some(Vote::Stiction), "{}", model.note);
+    assert!(
+        model
+            .note
+            .contains("keeps time like an input of fixed period"),
+        "{}",
+        model.note
+    );
+    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    // a sticky valve's cycle that regular, on which the band gains as much, is checked too and
+    // keeps the vote: over whole periods the band still explains what is left (fast-c-0047: a
+    // Kano valve, regularity 128, the band gaining 16 % of the PV's variation)
+    let d = judge_catalogue("fast-c-0047");
+    let model = model_family(&d);
+    assert!(d.oscillation.as_ref().unwrap().regularity.regularity >= FORCED_REGULARITY);
+    let c = model.model.as_ref().unwrap().cycle_cancelled.clone();
+    assert!(c.is_some_and(|c| c.significance > 15.0), "{}", model.note);
+    assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
 }

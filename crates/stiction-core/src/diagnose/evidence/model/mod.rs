@@ -25,7 +25,10 @@
 mod cycle;
 mod levels;
 
-pub use cycle::{CycleCancelled, CYCLE_CANCELLED_STICTION};
+use cycle::clock_regular;
+pub use cycle::{
+    CycleCancelled, CYCLE_CANCELLED_STICTION, FORCED_CROSSINGS, FORCED_GAIN, FORCED_REGULARITY,
+};
 pub use levels::{LevelsEvidence, LEVELS_STICTION, MAX_UNRECORDED};
 
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
@@ -252,6 +255,27 @@ impl EvidenceFamily for Model {
                 }
             }
         }
+        // a cycle as regular as an input of fixed period: is the band's gain the cycle's alone?
+        let mut withdrawn = false;
+        if vote == Vote::Stiction
+            && evidence.cycle_cancelled.is_none()
+            && clock_regular(ctx)
+            && improvement >= FORCED_GAIN
+        {
+            evidence.cycle_cancelled = CycleCancelled::of(ctx, f);
+            if let Some(c) = evidence
+                .cycle_cancelled
+                .as_ref()
+                .filter(|c| c.only_the_cycle())
+            {
+                why = format!(
+                    "{why}; but the cycle keeps time like an input of fixed period (regularity {:.0}), and {}: a band fits such an input's cycle too, so this is no vote",
+                    ctx.oscillation.regularity.regularity,
+                    c.words()
+                );
+                (vote, strength, withdrawn) = (Vote::Undetermined, 0.0, true);
+            }
+        }
         if vote != Vote::Stiction && levels.explained >= MIN_EXPLAINED {
             if let Some(s) = test.stiction_strength() {
                 why = format!("the levels test finds a sticky valve where the fit of PV's changes does not ({why})");
@@ -259,9 +283,10 @@ impl EvidenceFamily for Model {
             }
         }
         // measured, between the thresholds: the fit gains more than most healthy loops give
-        let leans = (vote == Vote::Undetermined
-            && levels.significance > SIGNIFICANCE_NONE
-            && levels.significance < SIGNIFICANCE_STICTION)
+        let leans = (withdrawn
+            || (vote == Vote::Undetermined
+                && levels.significance > SIGNIFICANCE_NONE
+                && levels.significance < SIGNIFICANCE_STICTION))
             .then_some(Vote::Stiction);
         FamilyEvidence {
             family: Family::Model,
