@@ -446,10 +446,9 @@ fn vote(ctx: &Context, f: &FitComparison, levels: &Levels) -> (Vote, f64, String
 mod tests {
     use super::*;
 
-    /// Strong only where OP plainly explains nothing; between, strong enough to stand as dissent
-    /// against a lone stiction vote (the verdict's weak dissent is 0.5) but far from decisive.
-    // the weak vote stands as dissent against a lone stiction vote, and is graded below the
-    // share under which the family votes this way at all
+    // strong only where OP plainly explains nothing; between, strong enough to stand as dissent
+    // against a lone stiction vote but far from decisive, and graded below the share under which
+    // the family votes this way at all
     const _: () = assert!(
         ELSEWHERE_WEAK_STRENGTH > crate::diagnose::verdict::WEAK_DISSENT
             && ELSEWHERE_WEAK_STRENGTH < 0.6
