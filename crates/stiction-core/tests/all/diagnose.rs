@@ -557,3 +557,31 @@ fn a_band_that_only_fits_a_clock_regular_cycle_is_no_vote() {
     assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
 }
+
+#[test]
+fn an_integrating_request_judges_the_levels_rate_for_stick_slip() {
+    // a sticky level valve: while it sticks the level ramps (the flows do not balance), its rate
+    // stays put; judged as a level the ramps leave PV's noise band, judged as a rate they count
+    let sticky = run(2.0, |cl| {
+        cl.process = Process::Integrating {
+            k: 0.05,
+            delay: 5.0,
+        };
+        cl.noise = 0.05;
+    });
+    let episodes = |integrating: bool| {
+        let req = DiagnoseRequest {
+            integrating,
+            ..quick()
+        };
+        let d = diagnose(&record(&sticky), &req).unwrap();
+        let f = d
+            .families
+            .iter()
+            .find(|f| f.family == Family::StickSlip)
+            .unwrap();
+        f.stick_slip.as_ref().unwrap().episodes
+    };
+    let (rate, level) = (episodes(true), episodes(false));
+    assert!(rate > level, "rate {rate}, level {level}");
+}

@@ -97,6 +97,8 @@ pub struct Settings<'a> {
     /// The process gain in units of the judged signal per OP unit (PV for a self-regulating
     /// process, PV's change per sample for an integrating one); `None` when unknown.
     pub gain: Option<f64>,
+    /// The way the judged signal moves when OP rises: 1 or -1 (the process gain's sign).
+    pub direction: f64,
     /// Process dead time, samples.
     pub dead_samples: usize,
     /// Samples the process takes to show most of a valve move (dead time and two time
@@ -221,8 +223,7 @@ fn judge(
     // against a disturbance moves OP as much, but PV does not then catch up)
     let end = (j + s.response_samples.max(3)).min(pv.len());
     let level = 0.5 * (lo + hi);
-    let sign = s.gain.map_or(1.0, f64::signum);
-    let expected = dir * sign;
+    let expected = dir * s.direction;
     let moved = pv[j..end]
         .iter()
         .map(|v| (v - level) * expected)
@@ -326,10 +327,10 @@ impl EvidenceFamily for StickSlip {
             ),
             None => (None, None, 0, 3),
         };
-        let integrating = ctx
-            .fits
-            .as_ref()
-            .map_or(ctx.req.integrating, |f| f.structure.integrating);
+        let direction = gain.map_or(1.0, f64::signum);
+        // (the request's: the closed-loop fits compare changes over a lag with self-regulating
+        // structures, whatever the process)
+        let integrating = ctx.req.integrating;
         let mut e = if integrating {
             // a level: while the valve sticks PV's rate stays put; judge the smoothed rate
             let rate = |x: &[f64]| -> Vec<f64> {
@@ -346,8 +347,10 @@ impl EvidenceFamily for StickSlip {
                 pv_quantum: None,
                 unrecorded: &ctx.unrecorded,
                 pv_linear: y_lin.as_deref(),
-                // the gain of an integrating fit is PV per second per OP unit
-                gain: gain.map(|g| g * ts),
+                // the fits' gain is that of PV's changes over their lag, not of its rate: the
+                // slip need only leave the rate's band the way OP pushed
+                gain: None,
+                direction,
                 dead_samples,
                 response_samples: response_samples.max(2 * RATE_SMOOTHING),
             };
@@ -360,6 +363,7 @@ impl EvidenceFamily for StickSlip {
                 unrecorded: &ctx.unrecorded,
                 pv_linear,
                 gain,
+                direction,
                 dead_samples,
                 response_samples,
             };
@@ -408,6 +412,7 @@ mod tests {
             unrecorded,
             pv_linear: None,
             gain: Some(1.0),
+            direction: 1.0,
             dead_samples: 2,
             response_samples: 3,
         }
@@ -480,6 +485,7 @@ mod tests {
         let unrecorded = vec![false; op.len()];
         let s = Settings {
             gain: Some(-1.0),
+            direction: -1.0,
             ..settings(&unrecorded)
         };
         let e = episodes(&op, &pv, &s);
