@@ -1,6 +1,7 @@
 //! The diagnosis: usable stretches, the families of evidence, the verdict, windows.
 
 use stiction_core::diagnose::evidence::model::{CYCLE_CANCELLED_STICTION, FORCED_REGULARITY};
+use stiction_core::diagnose::evidence::stick_slip::PV_BAND_SIGMAS;
 use stiction_core::diagnose::{
     diagnose, BandSource, DiagnoseRequest, Family, LoopRecord, Verdict, Vote,
 };
@@ -559,9 +560,9 @@ fn a_band_that_only_fits_a_clock_regular_cycle_is_no_vote() {
 }
 
 #[test]
-fn an_integrating_request_judges_the_levels_rate_for_stick_slip() {
-    // a sticky level valve: while it sticks the level ramps (the flows do not balance), its rate
-    // stays put; judged as a level the ramps leave PV's noise band, judged as a rate they count
+fn a_levels_stick_slip_episodes_are_judged_on_the_level_itself() {
+    // a sticky level valve: the stick-slip family looks for OP travelling while the level
+    // stays inside its own noise band (the band of PV, not of a rate)
     let sticky = run(2.0, |cl| {
         cl.process = Process::Integrating {
             k: 0.05,
@@ -569,19 +570,21 @@ fn an_integrating_request_judges_the_levels_rate_for_stick_slip() {
         };
         cl.noise = 0.05;
     });
-    let episodes = |integrating: bool| {
-        let req = DiagnoseRequest {
-            integrating,
-            ..quick()
-        };
-        let d = diagnose(&record(&sticky), &req).unwrap();
-        let f = d
-            .families
-            .iter()
-            .find(|f| f.family == Family::StickSlip)
-            .unwrap();
-        f.stick_slip.as_ref().unwrap().episodes
+    let req = DiagnoseRequest {
+        integrating: true,
+        ..quick()
     };
-    let (rate, level) = (episodes(true), episodes(false));
-    assert!(rate > level, "rate {rate}, level {level}");
+    let d = diagnose(&record(&sticky), &req).unwrap();
+    let f = d
+        .families
+        .iter()
+        .find(|f| f.family == Family::StickSlip)
+        .unwrap();
+    let e = f.stick_slip.as_ref().unwrap();
+    let band = PV_BAND_SIGMAS * stiction_core::detect::measurement_noise(&sticky.pv);
+    assert!(
+        (e.pv_band - band).abs() < 1e-12,
+        "{} against {band}",
+        e.pv_band
+    );
 }

@@ -281,7 +281,7 @@ fn leaning_reason(leaning: &[&FamilyEvidence]) -> String {
 
 /// Below this confidence a `no_stiction` rests only on weak votes against (a fit no better than
 /// healthy loops give, no stick-slip episode found), which a sticky valve often gives too: on the
-/// plant benchmark's routine windows such verdicts were right in 149 of 236 loops (63 %), those
+/// plant benchmark's routine windows such verdicts were right in 148 of 236 loops (63 %), those
 /// at 0.8 or more in 19 of 20 (docs/plant-benchmark.md, "What the confidence means here").
 const WEAK_NO_STICTION: f64 = 0.6;
 
