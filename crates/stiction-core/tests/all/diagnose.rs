@@ -199,13 +199,20 @@ fn windows_cover_the_record_and_bad_requests_are_errors() {
     assert!(diagnose(&r, &quick()).is_err());
 }
 
-#[test]
-fn integrating_loops_use_the_second_difference_histogram() {
-    let sticky = run(2.0, |cl| {
+/// A sticky valve (Stenman d = 2) on a level: an integrating process, K = 0.05 /s, delay 5 s.
+fn sticky_level(f: impl FnOnce(&mut ClosedLoop)) -> LoopData {
+    run(2.0, |cl| {
         cl.process = Process::Integrating {
             k: 0.05,
             delay: 5.0,
         };
+        f(cl);
+    })
+}
+
+#[test]
+fn integrating_loops_use_the_second_difference_histogram() {
+    let sticky = sticky_level(|cl| {
         cl.pi.kc = 2.0;
         cl.pi.ti = 100.0;
         cl.samples = 3000;
@@ -563,13 +570,7 @@ fn a_band_that_only_fits_a_clock_regular_cycle_is_no_vote() {
 fn a_levels_stick_slip_episodes_are_judged_on_the_level_itself() {
     // a sticky level valve: the stick-slip family looks for OP travelling while the level
     // stays inside its own noise band (the band of PV, not of a rate)
-    let sticky = run(2.0, |cl| {
-        cl.process = Process::Integrating {
-            k: 0.05,
-            delay: 5.0,
-        };
-        cl.noise = 0.05;
-    });
+    let sticky = sticky_level(|_| {});
     let req = DiagnoseRequest {
         integrating: true,
         ..quick()
