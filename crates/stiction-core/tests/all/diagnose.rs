@@ -553,7 +553,14 @@ fn a_band_that_only_fits_a_clock_regular_cycle_is_no_vote() {
         "{}",
         model.note
     );
-    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    assert!(m.gain_in_a_clock_regular_cycle, "{}", model.note);
+    assert_eq!(d.verdict, Verdict::Undetermined, "{:?}", d.evidence);
+    assert!(
+        d.next_step
+            .starts_with("look for an input at the cycle's period"),
+        "{}",
+        d.next_step
+    );
     // a sticky valve's cycle that regular, on which the band gains as much, is checked too and
     // keeps the vote: over whole periods the band still explains what is left (fast-c-0047: a
     // Kano valve, regularity 128, the band gaining 16 % of the PV's variation)
@@ -562,6 +569,7 @@ fn a_band_that_only_fits_a_clock_regular_cycle_is_no_vote() {
     assert!(d.oscillation.as_ref().unwrap().regularity.regularity >= FORCED_REGULARITY);
     let c = model.model.as_ref().unwrap().cycle_cancelled.clone();
     assert!(c.is_some_and(|c| c.significance > 15.0), "{}", model.note);
+    assert!(!model.model.as_ref().unwrap().gain_in_a_clock_regular_cycle);
     assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
 }

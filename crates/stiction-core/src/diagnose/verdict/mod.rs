@@ -304,6 +304,13 @@ fn next_step(
                 .as_ref()
                 .is_some_and(|m| m.explained < super::evidence::model::MIN_EXPLAINED)
     });
+    // the closed-loop fit's stiction vote withdrawn: its gain lay in a cycle that keeps time
+    let clock_cycle = families.iter().any(|f| {
+        f.family == Family::Model
+            && f.model
+                .as_ref()
+                .is_some_and(|m| m.gain_in_a_clock_regular_cycle)
+    });
     match verdict {
         Verdict::Stiction => {
             if families
@@ -327,6 +334,11 @@ fn next_step(
             if motion.setpoint_steady { STEADY_SETPOINT } else { "" }
         ),
         Verdict::NoStiction => "no action on the valve".into(),
+        Verdict::Undetermined if clock_cycle => format!(
+            "look for an input at the cycle's period, upstream or in an interacting loop (the cycle keeps time like one); \
+             without one, record the valve position (MV) or run a valve travel test to settle it{}",
+            if motion.setpoint_steady { STEADY_SETPOINT } else { "" }
+        ),
         Verdict::Undetermined => format!(
             "record the valve position (MV) or run a valve travel test to settle it{}",
             if motion.setpoint_steady { STEADY_SETPOINT } else { "" }

@@ -157,9 +157,14 @@ pub struct ModelEvidence {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub levels: Option<LevelsEvidence>,
     /// The fits compared over whole periods of the cycle, when the loop limit-cycles and the
-    /// first comparison finds the fits alike ([`CycleCancelled`]).
+    /// first comparison finds the fits alike, or to check a stiction vote on a cycle that keeps
+    /// time like an input of fixed period ([`CycleCancelled`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle_cancelled: Option<CycleCancelled>,
+    /// The stiction vote was withdrawn: the band's gain lay in a cycle that keeps time like an
+    /// input of fixed period, and over whole periods it gained nothing ([`FORCED_REGULARITY`]).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub gain_in_a_clock_regular_cycle: bool,
 }
 
 /// The statistics of a comparison: shares of the compared output's variance above its noise.
@@ -274,6 +279,7 @@ impl EvidenceFamily for Model {
                     c.words()
                 );
                 (vote, strength, withdrawn) = (Vote::Undetermined, 0.0, true);
+                evidence.gain_in_a_clock_regular_cycle = true;
             }
         }
         if vote != Vote::Stiction && levels.explained >= MIN_EXPLAINED {
@@ -344,6 +350,7 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
         calibration: CALIBRATION.into(),
         levels: None,
         cycle_cancelled: None,
+        gain_in_a_clock_regular_cycle: false,
     }
 }
 
