@@ -261,7 +261,6 @@ impl EvidenceFamily for Model {
             }
         }
         // a cycle as regular as an input of fixed period: is the band's gain the cycle's alone?
-        let mut withdrawn = false;
         if vote == Vote::Stiction
             && evidence.cycle_cancelled.is_none()
             && clock_regular(ctx)
@@ -278,7 +277,7 @@ impl EvidenceFamily for Model {
                     ctx.oscillation.regularity.regularity,
                     c.words()
                 );
-                (vote, strength, withdrawn) = (Vote::Undetermined, 0.0, true);
+                (vote, strength) = (Vote::Undetermined, 0.0);
                 evidence.gain_in_a_clock_regular_cycle = true;
             }
         }
@@ -289,7 +288,7 @@ impl EvidenceFamily for Model {
             }
         }
         // measured, between the thresholds: the fit gains more than most healthy loops give
-        let leans = (withdrawn
+        let leans = (evidence.gain_in_a_clock_regular_cycle
             || (vote == Vote::Undetermined
                 && levels.significance > SIGNIFICANCE_NONE
                 && levels.significance < SIGNIFICANCE_STICTION))
