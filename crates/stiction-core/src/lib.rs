@@ -39,6 +39,7 @@ pub mod detect;
 pub mod diagnose;
 pub mod estimate;
 pub mod fleet;
+pub mod hidden_valve;
 pub mod identify;
 pub mod loop_analysis;
 pub mod models;
