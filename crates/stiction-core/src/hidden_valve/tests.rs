@@ -36,17 +36,22 @@ fn record_of(d: f64, samples: usize) -> crate::sim::LoopData {
     cl.run().unwrap()
 }
 
+/// The record of `data` (sampled every 2 s) with the valve's travel `limits`.
+fn record(data: &crate::sim::LoopData, limits: Option<(f64, f64)>) -> Record<'_> {
+    Record {
+        op: &data.op,
+        pv: &data.pv,
+        ts: 2.0,
+        limits,
+    }
+}
+
 #[test]
 fn a_valve_that_cannot_stick_has_the_healthy_likelihood() {
     // law: a band of nothing, OP recorded exactly: every particle's valve is OP, so the particle
     // filter is the Kalman filter
     let data = record_of(0.0, 300);
-    let rec = Record {
-        op: &data.op,
-        pv: &data.pv,
-        ts: 2.0,
-        limits: Some((0.0, 100.0)),
-    };
+    let rec = record(&data, Some((0.0, 100.0)));
     let m = model();
     let healthy = healthy_log_likelihood(&rec, &m);
     let pf = Particles { count: 16, seed: 3 };
@@ -61,12 +66,7 @@ fn a_valve_that_cannot_stick_has_the_healthy_likelihood() {
 #[test]
 fn the_same_seed_gives_the_same_likelihood() {
     let data = record_of(2.0, 300);
-    let rec = Record {
-        op: &data.op,
-        pv: &data.pv,
-        ts: 2.0,
-        limits: None,
-    };
+    let rec = record(&data, None);
     let m = LoopModel {
         input_noise: 0.3,
         ..model()
@@ -100,12 +100,7 @@ fn at_the_true_loop_a_hidden_sticky_valve_explains_pv_and_a_healthy_one_is_not_m
     let pf = Particles { count: 64, seed: 5 };
     let ratio = |d: f64, band: f64| {
         let data = record_of(d, 600);
-        let rec = Record {
-            op: &data.op,
-            pv: &data.pv,
-            ts: 2.0,
-            limits: Some((0.0, 100.0)),
-        };
+        let rec = record(&data, Some((0.0, 100.0)));
         let m = true_model(&data);
         sticky_log_likelihood(&rec, &m, band, &pf) - healthy_log_likelihood(&rec, &m)
     };
@@ -127,12 +122,7 @@ fn the_search_finds_a_hidden_sticky_valve_and_no_band_in_a_healthy_one() {
     };
     let ratio = |d: f64| {
         let data = record_of(d, 400);
-        let rec = Record {
-            op: &data.op,
-            pv: &data.pv,
-            ts: 2.0,
-            limits: Some((0.0, 100.0)),
-        };
+        let rec = record(&data, Some((0.0, 100.0)));
         test(&rec, &settings).unwrap()
     };
     let sticky = ratio(3.0);
