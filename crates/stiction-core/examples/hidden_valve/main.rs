@@ -1,7 +1,7 @@
 //! How far the hidden-valve likelihood ratio (`stiction_core::hidden_valve`) separates sticky
 //! valves from healthy loops and their look-alikes on the catalogue's loops, beside `diagnose`.
 //!
-//!     cargo run --release -p stiction-core --example hidden_valve -- [--suite fast|routine] [--set calibration] [--only ID ...] [--particles N] [--out FILE]
+//!     cargo run --release -p stiction-core --example hidden_valve -- [--suite fast|routine] [--set calibration] [--only ID ...] [--particles N] [--sticky-starts N] [--out FILE]
 //!
 //! Each loop's whole record (OP and PV as recorded; the valve's travel 0-100 % of span) is judged
 //! by the ratio, with its loop model found by coordinate ascent under each hypothesis
@@ -34,7 +34,7 @@ struct Judged {
 
 const THRESHOLDS: [f64; 4] = [10.0, 20.0, 30.0, 50.0];
 
-fn judge(l: &BenchmarkLoop, particles: usize) -> Judged {
+fn judge(l: &BenchmarkLoop, particles: usize, sticky_starts: usize) -> Judged {
     let start = Instant::now();
     let settings = TestSettings {
         integrating: l.integrating,
@@ -42,6 +42,7 @@ fn judge(l: &BenchmarkLoop, particles: usize) -> Judged {
             count: particles,
             seed: 1,
         },
+        sticky_starts,
         ..TestSettings::default()
     };
     let rec = Record {
@@ -87,6 +88,8 @@ fn main() {
     };
     let particles: usize =
         arg(&args, "--particles").map_or(100, |v| v.parse().expect("--particles N"));
+    let sticky_starts: usize =
+        arg(&args, "--sticky-starts").map_or(2, |v| v.parse().expect("--sticky-starts N"));
     let only: Vec<&String> = args
         .iter()
         .enumerate()
@@ -122,7 +125,10 @@ fn main() {
             .filter(|l| only.is_empty() || only.contains(&&l.id))
             .collect();
         let start = Instant::now();
-        let judged: Vec<Judged> = loops.par_iter().map(|l| judge(l, particles)).collect();
+        let judged: Vec<Judged> = loops
+            .par_iter()
+            .map(|l| judge(l, particles, sticky_starts))
+            .collect();
         for j in &judged {
             eprintln!(
                 "{} {} {:?} ratio {:.1} band {:.2} diagnose {:?} ({:.2} s)",

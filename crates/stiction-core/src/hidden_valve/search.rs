@@ -22,6 +22,8 @@ pub struct TestSettings {
     pub input_noise: f64,
     /// The particle filter's settings.
     pub particles: Particles,
+    /// The sticky hypothesis is searched from this many of the best healthy optima.
+    pub sticky_starts: usize,
 }
 
 impl Default for TestSettings {
@@ -33,6 +35,7 @@ impl Default for TestSettings {
             integrating: false,
             input_noise: 0.5,
             particles: Particles::default(),
+            sticky_starts: 2,
         }
     }
 }
@@ -219,7 +222,7 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
     };
     let (l1, m1, band) = optima
         .iter()
-        .take(2)
+        .take(set.sticky_starts.max(1))
         .map(|(_, m)| sticky_optimum(&mut sticky, m, &bands, &scales))
         .fold((f64::NEG_INFINITY, start, bands[0]), |a, b| {
             if b.0 > a.0 {
