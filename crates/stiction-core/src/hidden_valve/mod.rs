@@ -13,7 +13,8 @@
 //! searched again from the sticky one's optimum, so the ratio is never an artefact of a search
 //! that stopped short.
 //!
-//! This is a study (`examples/hidden_valve`, `docs/hidden-valve.md`): no family votes on it yet.
+//! This is a study (`examples/hidden_valve`; `docs/hidden-valve-fast.md` and
+//! `docs/hidden-valve-routine.md`): no family votes on it yet.
 
 mod coordinates;
 mod likelihood;
