@@ -65,6 +65,8 @@ pub(super) fn set(m: &mut LoopModel, c: Coordinate, v: f64) {
 }
 
 /// Robust standard deviation of a series' sample-to-sample changes, over √2 (white noise's own).
+/// Unlike `diagnose::oscillation::noise_std` it measures the changes' spread about their median,
+/// so a steady ramp of PV does not count as noise.
 pub(super) fn step_noise(x: &[f64]) -> f64 {
     let mut d: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
     if d.is_empty() {

@@ -104,6 +104,13 @@ pub fn sticky_log_likelihood(rec: &Record, m: &LoopModel, band: f64, pf: &Partic
         .collect();
     let mut log_w = vec![0.0; n];
     let (mut ll, mut weights) = (0.0, vec![0.0; n]);
+    // resampling's buffers, kept from one resampling to the next
+    let mut picks = Vec::with_capacity(n);
+    let mut spare: (Vec<f64>, Vec<[f64; STATES]>, Vec<f64>) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(ring.len()),
+    );
     for t in 0..rec.pv.len() {
         let (g, s) = gains.at(t);
         let slot = t % (k + 1);
@@ -136,23 +143,32 @@ pub fn sticky_log_likelihood(rec: &Record, m: &LoopModel, band: f64, pf: &Partic
         }
         if sum * sum / sum_sq < 0.5 * n as f64 || t + 1 == rec.pv.len() {
             ll += top + (sum / n as f64).ln();
-            let picks = systematic(&weights, sum, rng.random::<f64>());
-            valve = picks.iter().map(|&j| valve[j]).collect();
-            means = picks.iter().map(|&j| means[j]).collect();
-            ring = picks
-                .iter()
-                .flat_map(|&j| ring[j * (k + 1)..(j + 1) * (k + 1)].to_vec())
-                .collect();
+            // the drawn particles into the spare buffers, which then take the old ones' place
+            systematic(&weights, sum, rng.random::<f64>(), &mut picks);
+            spare.0.clear();
+            spare.0.extend(picks.iter().map(|&j| valve[j]));
+            spare.1.clear();
+            spare.1.extend(picks.iter().map(|&j| means[j]));
+            spare.2.clear();
+            for &j in &picks {
+                spare
+                    .2
+                    .extend_from_slice(&ring[j * (k + 1)..(j + 1) * (k + 1)]);
+            }
+            std::mem::swap(&mut valve, &mut spare.0);
+            std::mem::swap(&mut means, &mut spare.1);
+            std::mem::swap(&mut ring, &mut spare.2);
             log_w.iter_mut().for_each(|l| *l = 0.0);
         }
     }
     ll
 }
 
-/// Systematic resampling: the particles drawn, in order, for weights summing to `sum`.
-fn systematic(weights: &[f64], sum: f64, offset: f64) -> Vec<usize> {
+/// Systematic resampling: the particles drawn, in order, for weights summing to `sum`, into
+/// `picks`.
+fn systematic(weights: &[f64], sum: f64, offset: f64, picks: &mut Vec<usize>) {
     let n = weights.len();
-    let mut picks = Vec::with_capacity(n);
+    picks.clear();
     let (mut j, mut acc) = (0, weights[0] / sum);
     for i in 0..n {
         let u = (offset + i as f64) / n as f64;
@@ -162,5 +178,4 @@ fn systematic(weights: &[f64], sum: f64, offset: f64) -> Vec<usize> {
         }
         picks.push(j);
     }
-    picks
 }
