@@ -14,6 +14,7 @@ fn band_source(s: BandSource) -> &'static str {
         BandSource::DescribingFunction => "describing function of the limit cycle",
         BandSource::Levels => "levels test's best valve",
         BandSource::Ellipse => "width of the oscillation's PV-OP ellipse",
+        BandSource::HiddenValve => "hidden-valve test, a grid of bands",
     }
 }
 

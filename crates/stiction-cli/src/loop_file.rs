@@ -105,7 +105,9 @@ pub struct Columns {
     pub estimate_start: bool,
     /// Model family: also score every distinct Stenman valve on PV's levels (the levels test;
     /// finds more sticky valves in records sampled at every controller execution, 1 to 3 s
-    /// a loop of 2,000 samples)
+    /// a loop of 2,000 samples); where no family has decided stiction on a limit cycle, also the
+    /// hidden-valve family (a particle filter over a valve that slips between the samples,
+    /// about 4 to 6 s more)
     #[arg(long)]
     pub thorough: bool,
     #[command(flatten)]

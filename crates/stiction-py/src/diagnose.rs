@@ -16,7 +16,7 @@ pub struct Settings {
     pub quantify: bool,
     pub op_range: [f64; 2],
     pub estimate_start: bool,
-    /// The model family's levels test (the CLI's `--thorough`).
+    /// The model family's levels test and the hidden-valve family (the CLI's `--thorough`).
     pub thorough: bool,
     /// The time column's name, for the sentence when time does not increase.
     pub time_name: String,

@@ -1,15 +1,19 @@
-//! `--thorough`: the model family's levels test, as a user asks for it.
+//! `--thorough`: the model family's levels test and the hidden-valve family, as a user asks for
+//! them.
 
 use crate::common;
 use common::{closed_stenman, json, ok};
 
-fn model(v: &serde_json::Value) -> &serde_json::Value {
+fn family<'a>(v: &'a serde_json::Value, name: &str) -> Option<&'a serde_json::Value> {
     v["families"]
         .as_array()
         .unwrap()
         .iter()
-        .find(|f| f["family"] == "model")
-        .unwrap()
+        .find(|f| f["family"] == name)
+}
+
+fn model(v: &serde_json::Value) -> &serde_json::Value {
+    family(v, "model").unwrap()
 }
 
 /// Setpoint steps in a loop tuned calmly: the valve sticks between steps (no limit cycle).
@@ -41,12 +45,19 @@ fn the_levels_test_finds_the_band_of_a_sticky_valve_and_nothing_in_a_healthy_one
     assert_eq!(m["vote"], "stiction", "{m:#}");
     assert!(m["note"].as_str().unwrap().contains("levels test"), "{m:#}");
     assert_eq!(v["verdict"], "stiction");
+    // decided already: the hidden valve, which costs seconds, is not run
+    let hidden = family(&v, "hidden_valve").unwrap();
+    assert!(
+        hidden["note"].as_str().unwrap().starts_with("not run"),
+        "{hidden:#}"
+    );
     // the human output names the test
     let text = ok(&["diagnose", s, "--sp", "sp", "--thorough", "--no-quantify"]);
     assert!(text.contains("levels test"), "{text}");
     // without the flag the test is not run
     let plain = json(&ok(&["diagnose", s, "--sp", "sp", "--json"]));
     assert!(model(&plain)["model"].get("levels").is_none());
+    assert!(family(&plain, "hidden_valve").is_none());
 
     let healthy = dir.path().join("healthy.csv");
     closed_stenman(&healthy, "0", &STEPS);
@@ -59,4 +70,18 @@ fn the_levels_test_finds_the_band_of_a_sticky_valve_and_nothing_in_a_healthy_one
         "{m:#}"
     );
     assert_eq!(v["verdict"], "no_stiction", "{v:#}");
+    // no limit cycle: the hidden valve is calibrated on limit cycles and says why it is silent
+    let hidden = family(&v, "hidden_valve").unwrap();
+    assert_eq!(hidden["vote"], "undetermined", "{hidden:#}");
+    assert!(
+        hidden["note"]
+            .as_str()
+            .unwrap()
+            .contains("does not oscillate"),
+        "{hidden:#}"
+    );
+    assert!(
+        hidden["threshold"].as_str().unwrap().contains("60"),
+        "{hidden:#}"
+    );
 }

@@ -32,7 +32,8 @@ mod confidence;
 mod spread;
 mod tables;
 use tables::{
-    by_class, goals, levels_table, reason_table, sticky_table, verdict_table, vote_table,
+    by_class, goals, hidden_valve_table, levels_table, reason_table, sticky_table, verdict_table,
+    vote_table,
 };
 
 use rayon::prelude::*;
@@ -52,7 +53,8 @@ const VERDICTS: [Verdict; 4] = [
     Verdict::InsufficientData,
 ];
 
-/// `--thorough`: the model family also runs the levels test (`DiagnoseRequest::thorough`).
+/// `--thorough`: the model family also runs the levels test, and the hidden-valve family runs
+/// (`DiagnoseRequest::thorough`).
 static THOROUGH: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 struct Options {
@@ -224,6 +226,7 @@ fn run_suite(o: &Options, suite: Suite, md: &mut String, jsonl: &mut String) {
     breakdown::breakdown_tables(md, &groups);
     if THOROUGH.load(std::sync::atomic::Ordering::Relaxed) {
         levels_table(md, &groups);
+        hidden_valve_table(md, &groups);
     }
     vote_table(md, &groups);
     reason_table(md, &groups);
@@ -299,7 +302,9 @@ fn main() {
         },
         if thorough {
             "Every loop is judged with `--thorough`: the model family also runs the levels test (every distinct Stenman \
-             valve scored on PV's levels, AR noise model; `stiction_core::identify::levels`). Beside \
+             valve scored on PV's levels, AR noise model; `stiction_core::identify::levels`), and where the other families \
+             have not decided `stiction`, the hidden-valve family (a sticky valve whose position the record does not hold, \
+             a particle filter; `stiction_core::diagnose::evidence::hidden_valve`). Beside \
              [plant-benchmark.md](plant-benchmark.md), the same loops judged without it. "
         } else {
             ""

@@ -75,6 +75,49 @@ pub(super) fn levels_table(md: &mut String, groups: &Groups) {
     let _ = writeln!(md);
 }
 
+/// With `--thorough`: the hidden-valve family per class (where it ran, its ratio, its votes).
+pub(super) fn hidden_valve_table(md: &mut String, groups: &Groups) {
+    use stiction_core::diagnose::evidence::hidden_valve::THRESHOLD;
+    use stiction_core::diagnose::{Family, Vote};
+    let _ = writeln!(
+        md,
+        "The hidden-valve family (with `--thorough`; it runs where the other families have not decided `stiction`, on an oscillating \
+         loop with PV recorded and OP within 10 % of span, and votes stiction from a ratio of {THRESHOLD:.0}):\n"
+    );
+    let _ = writeln!(
+        md,
+        "| class | not run (already stiction) | gated out | judged | median ratio | highest | votes stiction |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
+    for (class, of) in groups {
+        let fams: Vec<_> = of
+            .iter()
+            .filter_map(|(_, d)| d.families.iter().find(|f| f.family == Family::HiddenValve))
+            .collect();
+        let mut r: Vec<f64> = fams
+            .iter()
+            .filter_map(|f| f.hidden_valve.as_ref().map(|h| h.ratio))
+            .collect();
+        r.sort_by(f64::total_cmp);
+        let not_run = fams
+            .iter()
+            .filter(|f| f.note.starts_with("not run"))
+            .count();
+        let votes = fams.iter().filter(|f| f.vote == Vote::Stiction).count();
+        let median = r.get(r.len().saturating_sub(1) / 2).copied();
+        let fmt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
+        let _ = writeln!(
+            md,
+            "| {class} | {not_run} | {} | {} | {} | {} | {votes} |",
+            fams.len() - not_run - r.len(),
+            r.len(),
+            fmt(median),
+            fmt(r.last().copied()),
+        );
+    }
+    let _ = writeln!(md);
+}
+
 pub(super) fn verdict_table(md: &mut String, groups: &Groups) {
     let _ = writeln!(
         md,

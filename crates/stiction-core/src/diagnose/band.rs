@@ -80,6 +80,8 @@ struct Beside<'a> {
     self_sustained: bool,
     /// The levels test's band, when it reached its threshold.
     levels: Option<f64>,
+    /// The hidden-valve family's band, when it voted stiction.
+    hidden: Option<f64>,
     /// The OP's measurement noise standard deviation (from its differences), OP units.
     op_noise: f64,
 }
@@ -123,6 +125,10 @@ impl<'a> Beside<'a> {
                 )
             })
             .map(|el| el.width_along_x);
+        let hidden = family(Family::HiddenValve)
+            .filter(|f| f.vote == super::Vote::Stiction)
+            .and_then(|f| f.hidden_valve.as_ref())
+            .map(|h| h.band);
         Self {
             valve,
             stick,
@@ -130,6 +136,7 @@ impl<'a> Beside<'a> {
             ellipse,
             self_sustained,
             levels,
+            hidden,
             // as the families measured it, on the same stretch
             op_noise: family(Family::StickSlip)
                 .and_then(|f| f.stick_slip.as_ref())
@@ -162,7 +169,7 @@ pub(super) fn size(
 ) {
     let beside = Beside::new(d, sub, offset, osc, req.ts);
     let (stick, describing, ellipse) = (beside.stick, beside.describing, beside.ellipse);
-    let (self_sustained, levels) = (beside.self_sustained, beside.levels);
+    let (self_sustained, levels, hidden) = (beside.self_sustained, beside.levels, beside.hidden);
     // what stands in for a band the fits do not resolve
     let stand_in = ellipse
         .map(|e| (e, BandSource::Ellipse))
@@ -232,6 +239,9 @@ pub(super) fn size(
     unresolved(d, &mut band, stand_in, op_noise, req);
     if let Some(t) = stick.filter(|_| band.source != BandSource::StickSlip) {
         band.others.push((BandSource::StickSlip, pct(t)));
+    }
+    if let Some(h) = hidden {
+        band.others.push((BandSource::HiddenValve, pct(h)));
     }
     if let Some(b) = describing.filter(|_| band.source != BandSource::DescribingFunction) {
         band.others.push((BandSource::DescribingFunction, pct(b)));

@@ -6,7 +6,8 @@
 //! - `bridge`, `stretch` and `gates`: short gaps bridged, the usable stretches and the
 //!   data-quality findings;
 //! - [`oscillation`]: does the loop oscillate (for the shape family);
-//! - [`evidence`]: the families (shape, model, stick-slip, valve), one file each behind a trait;
+//! - [`evidence`]: the families (valve, model, stick-slip, shape, loop and, with `thorough`, the
+//!   hidden valve), one file each behind a trait;
 //! - `verdict`: families that agree decide, families that conflict give `undetermined`;
 //! - `band`: when the verdict is `stiction`, the band in % of valve span and where it comes from;
 //! - `windows`: the same judgement per window of the record.
@@ -84,11 +85,22 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         fits: compare_fits(r.op, r.pv, &compare),
         indices: Default::default(),
     };
-    let families: Vec<FamilyEvidence> = evidence::all().iter().map(|f| f.evaluate(&ctx)).collect();
-    let decision = verdict::decide(
-        &families,
-        &verdict::Motion::of(&ctx.oscillation, req.ts, r.sp),
-    );
+    let mut families: Vec<FamilyEvidence> =
+        evidence::all().iter().map(|f| f.evaluate(&ctx)).collect();
+    let motion = verdict::Motion::of(&ctx.oscillation, req.ts, r.sp);
+    let mut decision = verdict::decide(&families, &motion);
+    // the hidden valve costs seconds: only with `thorough`, only where it can change the verdict
+    if req.thorough {
+        if decision.verdict == Verdict::Stiction {
+            families.push(evidence::hidden_valve::not_needed());
+        } else {
+            families.push(evidence::EvidenceFamily::evaluate(
+                &evidence::hidden_valve::HiddenValve,
+                &ctx,
+            ));
+            decision = verdict::decide(&families, &motion);
+        }
+    }
     let Context {
         oscillation,
         indices,

@@ -34,7 +34,9 @@ pub struct DiagnoseRequest {
     pub op_range: [f64; 2],
     /// The model family also runs the levels test ([`crate::identify::levels`]): every distinct
     /// Stenman valve scored on PV's levels. Finds more sticky valves on records sampled at every
-    /// controller execution, at 1 to 3 s a loop of 2,000 samples.
+    /// controller execution, at 1 to 3 s a loop of 2,000 samples. Where the other families have
+    /// not decided `stiction`, the hidden-valve family runs too
+    /// ([`super::evidence::hidden_valve`]; 4 to 6 s more where it judges).
     #[serde(default)]
     pub thorough: bool,
 }

@@ -123,6 +123,8 @@ pub enum BandSource {
     /// The width of the PV-OP ellipse of the oscillation (along OP), where the fits resolve no
     /// band.
     Ellipse,
+    /// The hidden-valve family's best band (a grid of 10 bands, 0.3-8 % of span).
+    HiddenValve,
 }
 
 impl BandSource {
@@ -137,6 +139,7 @@ impl BandSource {
             BandSource::DescribingFunction => "the describing function of the loop's limit cycle",
             BandSource::Levels => "the levels test's best valve",
             BandSource::Ellipse => "the width of the oscillation's PV-OP ellipse",
+            BandSource::HiddenValve => "the hidden-valve test's band",
         }
     }
 }
@@ -153,6 +156,7 @@ impl BandSource {
             BandSource::DescribingFunction => "describing_function",
             BandSource::Levels => "levels",
             BandSource::Ellipse => "ellipse",
+            BandSource::HiddenValve => "hidden_valve",
         }
     }
 }

@@ -78,7 +78,9 @@ def diagnose(
     op_range: OP of a closed and a fully open valve; the band is in % of this span.
     thorough: the closed-loop fit also runs the levels test (every distinct Stenman valve scored
         on PV's levels): more sticky valves found on records sampled at every controller
-        execution, at 1 to 3 s a loop of 2,000 samples.
+        execution, at 1 to 3 s a loop of 2,000 samples; where no family has decided stiction on
+        a limit cycle, also the hidden-valve family (a particle filter over a valve that slips
+        between the samples; 4 to 6 s more).
 
     Missing values (NaN, None, historian states such as "Bad Input") are gaps.
     """

@@ -7,8 +7,11 @@
 //! - [`stick_slip`]: episodes of OP travelling while PV stays put, ended by a PV jump;
 //! - [`valve`]: the recorded valve position against OP, when MV is recorded;
 //! - [`limit_cycle`]: a limit cycle that no linear loop can sustain (the identified loop, its
-//!   margin and the describing function of a band).
+//!   margin and the describing function of a band);
+//! - [`hidden_valve`] (with `thorough`): a sticky valve whose position the record does not hold,
+//!   as a likelihood ratio, where the other families have not decided stiction.
 
+pub mod hidden_valve;
 pub mod limit_cycle;
 pub mod model;
 pub mod shape;
@@ -20,6 +23,7 @@ use super::result::{Oscillation, Vote};
 use crate::quantify::FitComparison;
 use serde::{Deserialize, Serialize};
 
+pub use hidden_valve::HiddenValveEvidence;
 pub use limit_cycle::LoopEvidence;
 pub use model::ModelEvidence;
 pub use stick_slip::StickSlipEvidence;
@@ -39,6 +43,8 @@ pub enum Family {
     Valve,
     /// The identified loop and its limit cycle.
     Loop,
+    /// A sticky valve whose position the record does not hold (`thorough`).
+    HiddenValve,
 }
 
 impl Family {
@@ -50,6 +56,7 @@ impl Family {
             Family::StickSlip => "stick_slip",
             Family::Valve => "valve",
             Family::Loop => "loop",
+            Family::HiddenValve => "hidden_valve",
         }
     }
 
@@ -61,6 +68,7 @@ impl Family {
             Family::StickSlip => "stick-slip episodes",
             Family::Valve => "valve position",
             Family::Loop => "linear loop",
+            Family::HiddenValve => "hidden valve",
         }
     }
 }
@@ -99,6 +107,9 @@ pub struct FamilyEvidence {
     /// The loop family's details (on its evidence only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limit_cycle: Option<LoopEvidence>,
+    /// The hidden-valve family's details (on its evidence only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hidden_valve: Option<HiddenValveEvidence>,
 }
 
 impl FamilyEvidence {
@@ -117,6 +128,7 @@ impl FamilyEvidence {
             stick_slip: None,
             valve: None,
             limit_cycle: None,
+            hidden_valve: None,
         }
     }
 }

@@ -110,6 +110,7 @@ impl EvidenceFamily for Shape {
             stick_slip: None,
             valve: None,
             limit_cycle: None,
+            hidden_valve: None,
         }
     }
 }

@@ -365,6 +365,7 @@ impl EvidenceFamily for StickSlip {
             stick_slip: Some(e),
             valve: None,
             limit_cycle: None,
+            hidden_valve: None,
         }
     }
 }

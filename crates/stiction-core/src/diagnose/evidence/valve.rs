@@ -136,6 +136,7 @@ impl EvidenceFamily for Valve {
             stick_slip: None,
             valve: Some(evidence),
             limit_cycle: None,
+            hidden_valve: None,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The verdict from the families: families that agree give `stiction` or `no_stiction` with a
 //! confidence; families that conflict give `undetermined`, naming the conflict. The valve family
-//! (the recorded valve position) outweighs the indirect ones. Against the loop family's evidence
+//! (the recorded valve position) outweighs the indirect ones, then the hidden valve's stiction
+//! vote (with `thorough`). Against the loop family's evidence
 //! of a non-linearity, the shape, fit and stick-slip votes against stiction count only weakly.
 //! A family whose statistic lies between its thresholds casts no vote but says which way it
 //! leans: with no vote cast, such a record is `undetermined` (judged, too weak to decide), not
@@ -101,6 +102,27 @@ fn by_valve(families: &[FamilyEvidence]) -> Option<(Verdict, f64)> {
     Some((verdict, 0.8 + 0.2 * share))
 }
 
+/// The hidden-valve family's stiction vote decides (its threshold lies above every look-alike of
+/// the calibration sets, and the families it overrules read the recorded OP as the valve's input,
+/// which is what it shows to be wrong): the confidence, from 0.6 (every other voting family
+/// against) to 0.9 (all agree).
+fn by_hidden_valve(families: &[FamilyEvidence]) -> Option<f64> {
+    families
+        .iter()
+        .find(|f| f.family == Family::HiddenValve && f.vote == Vote::Stiction)?;
+    let others: Vec<&FamilyEvidence> = families
+        .iter()
+        .filter(|f| f.family != Family::HiddenValve && f.vote != Vote::Undetermined)
+        .collect();
+    let agree = others.iter().filter(|f| f.vote == Vote::Stiction).count();
+    let share = if others.is_empty() {
+        1.0
+    } else {
+        agree as f64 / others.len() as f64
+    };
+    Some(0.6 + 0.3 * share)
+}
+
 /// What the oscillation tells a verdict that no family could judge.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Motion {
@@ -159,6 +181,15 @@ pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
             confidence: Some(confidence),
             reason: None,
             next_step: next_step(verdict, Some(confidence), families, motion),
+            evidence,
+        };
+    }
+    if let Some(confidence) = by_hidden_valve(families) {
+        return Decision {
+            verdict: Verdict::Stiction,
+            confidence: Some(confidence),
+            reason: None,
+            next_step: next_step(Verdict::Stiction, Some(confidence), families, motion),
             evidence,
         };
     }

@@ -79,3 +79,28 @@ fn weak_evidence_against_stiction_says_so_in_the_next_step() {
     assert_eq!(d.verdict, Verdict::NoStiction);
     assert_eq!(d.next_step, "no action on the valve");
 }
+
+#[test]
+fn the_hidden_valve_outweighs_the_families_that_read_op_as_the_valve_input() {
+    let mut against = vec![
+        family(Family::Model, Vote::NoStiction, None),
+        family(Family::StickSlip, Vote::NoStiction, None),
+        family(Family::HiddenValve, Vote::Undetermined, None),
+    ];
+    assert_eq!(decide(&against, &calm()).verdict, Verdict::NoStiction);
+    against[2].vote = Vote::Stiction;
+    let d = decide(&against, &calm());
+    assert_eq!(d.verdict, Verdict::Stiction);
+    // every other voting family against: the lowest confidence it gives
+    assert!(
+        (d.confidence.unwrap() - 0.6).abs() < 1e-12,
+        "{:?}",
+        d.confidence
+    );
+    assert!(d.next_step.contains("valve travel test"), "{}", d.next_step);
+    // the recorded valve position still decides over it
+    let mut valve = family(Family::Valve, Vote::NoStiction, None);
+    valve.strength = 0.9;
+    against.push(valve);
+    assert_eq!(decide(&against, &calm()).verdict, Verdict::NoStiction);
+}

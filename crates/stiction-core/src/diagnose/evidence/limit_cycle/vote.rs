@@ -29,6 +29,7 @@ pub(super) fn vote(mut e: LoopEvidence, statistic: &str, threshold: String) -> F
         stick_slip: None,
         valve: None,
         limit_cycle: Some(e),
+        hidden_valve: None,
     }
 }
 

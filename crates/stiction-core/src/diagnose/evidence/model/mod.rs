@@ -309,6 +309,7 @@ impl EvidenceFamily for Model {
             stick_slip: None,
             valve: None,
             limit_cycle: None,
+            hidden_valve: None,
         }
     }
 }
