@@ -113,6 +113,8 @@ pub fn sticky_log_likelihood(rec: &Record, m: &LoopModel, band: f64, pf: &Partic
     );
     for t in 0..rec.pv.len() {
         let (g, s) = gains.at(t);
+        // the log density's constant, shared by every particle at this step
+        let log_s = (std::f64::consts::TAU * s).ln();
         let slot = t % (k + 1);
         for i in 0..n {
             let seen = rec.op[t] + m.input_noise * gaussian(&mut rng);
@@ -127,7 +129,7 @@ pub fn sticky_log_likelihood(rec: &Record, m: &LoopModel, band: f64, pf: &Partic
             let mean = &mut means[i];
             predict(&mat.f, mat.b[0], mean, u);
             let e = innovation(mean, rec.pv[t]);
-            log_w[i] += log_density(e, s);
+            log_w[i] += -0.5 * (log_s + e * e / s);
             update(mean, g, e);
         }
         let top = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);

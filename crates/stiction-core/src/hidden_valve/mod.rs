@@ -13,8 +13,9 @@
 //! searched again from the sticky one's optimum, so the ratio is never an artefact of a search
 //! that stopped short.
 //!
-//! This is a study (`examples/hidden_valve`; `docs/hidden-valve-fast.md` and
-//! `docs/hidden-valve-routine.md`): no family votes on it yet.
+//! The study (`examples/hidden_valve`; `docs/hidden-valve-fast.md` and
+//! `docs/hidden-valve-routine.md`) set where it holds; `diagnose --thorough` runs it there as the
+//! hidden-valve family ([`crate::diagnose::evidence::hidden_valve`]).
 
 mod coordinates;
 mod likelihood;
