@@ -139,7 +139,9 @@ impl BandSource {
             BandSource::DescribingFunction => "the describing function of the loop's limit cycle",
             BandSource::Levels => "the levels test's best valve",
             BandSource::Ellipse => "the width of the oscillation's PV-OP ellipse",
-            BandSource::HiddenValve => "the hidden-valve test's band (the best of 10 from 0.3 to 8 % of span)",
+            BandSource::HiddenValve => {
+                "the hidden-valve test's band (the best of 10 from 0.3 to 8 % of span)"
+            }
         }
     }
 }

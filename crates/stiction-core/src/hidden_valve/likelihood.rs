@@ -83,11 +83,29 @@ impl Default for Particles {
     }
 }
 
-/// Log-likelihood of PV when a Stenman valve of band `band` (OP units) stands between OP and
-/// the process: it holds until OP, as the controller moved it between the samples too (the
-/// recorded OP plus the input noise), leaves the band, then jumps to it. The valve's position
-/// is hidden; each particle carries one and the loop's state given it.
-pub fn sticky_log_likelihood(rec: &Record, m: &LoopModel, band: f64, pf: &Particles) -> f64 {
+/// The hidden valve: it holds until OP leaves the band, then slips to `short` before OP (OP
+/// units; 0: Stenman's valve, which lands on OP; He's valve with `fs = band`, `fd = short`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Slip {
+    /// The band OP must leave for the valve to move, OP units.
+    pub band: f64,
+    /// How far short of OP a slip lands, OP units (less than the band).
+    pub short: f64,
+}
+
+impl Slip {
+    /// Stenman's valve of band `band`: a slip lands on OP.
+    pub fn stenman(band: f64) -> Self {
+        Self { band, short: 0.0 }
+    }
+}
+
+/// Log-likelihood of PV when a sticky valve (`slip`) stands between OP and the process: it
+/// holds until OP, as the controller moved it between the samples too (the recorded OP plus the
+/// input noise), leaves the band, then slips to it (or `slip.short` before it). The valve's
+/// position is hidden; each particle carries one and the loop's state given it.
+pub fn sticky_log_likelihood(rec: &Record, m: &LoopModel, slip: Slip, pf: &Particles) -> f64 {
+    let Slip { band, short } = slip;
     let mat = m.matrices(rec.ts);
     let (mean0, p0) = rec.start(m);
     let gains = Gains::of(&mat, p0, rec.pv.len());
@@ -118,8 +136,10 @@ pub fn sticky_log_likelihood(rec: &Record, m: &LoopModel, band: f64, pf: &Partic
         let slot = t % (k + 1);
         for i in 0..n {
             let seen = rec.op[t] + m.input_noise * gaussian(&mut rng);
-            if (seen - valve[i]).abs() > band {
-                valve[i] = rec.clip(seen);
+            let gap = seen - valve[i];
+            if gap.abs() > band {
+                // short = 0 lands on OP exactly (seen - ±0)
+                valve[i] = rec.clip(seen - short.copysign(gap));
             }
             // this sample's position in its slot; the input is the position k samples ago, in
             // the slot written next

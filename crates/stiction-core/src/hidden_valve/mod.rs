@@ -22,7 +22,7 @@ mod likelihood;
 mod model;
 mod search;
 
-pub use likelihood::{healthy_log_likelihood, sticky_log_likelihood, Particles, Record};
+pub use likelihood::{healthy_log_likelihood, sticky_log_likelihood, Particles, Record, Slip};
 pub use model::{LoopModel, STATES};
 pub use search::{test, HiddenValveTest, TestSettings};
 

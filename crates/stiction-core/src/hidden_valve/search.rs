@@ -3,7 +3,7 @@
 use super::coordinates::{
     cycle_angle, gain_sign, set, step_noise, values, Coordinate, Scales, LOADS, PROCESS,
 };
-use super::likelihood::{healthy_log_likelihood, sticky_log_likelihood, Particles, Record};
+use super::likelihood::{healthy_log_likelihood, sticky_log_likelihood, Particles, Record, Slip};
 use super::model::LoopModel;
 
 /// How the test searches.
@@ -24,6 +24,9 @@ pub struct TestSettings {
     pub particles: Particles,
     /// The sticky hypothesis is searched from this many of the best healthy optima.
     pub sticky_starts: usize,
+    /// How far short of OP a slip may land, as shares of the band, each tried with every band
+    /// (`[0.0]`: Stenman's valve alone; He's valve lands `fd` short of OP).
+    pub short_shares: &'static [f64],
 }
 
 impl Default for TestSettings {
@@ -36,6 +39,7 @@ impl Default for TestSettings {
             input_noise: 0.5,
             particles: Particles::default(),
             sticky_starts: 2,
+            short_shares: &[0.0],
         }
     }
 }
@@ -47,6 +51,8 @@ pub struct HiddenValveTest {
     pub ratio: f64,
     /// The sticky hypothesis's best band, OP units.
     pub band: f64,
+    /// How far short of OP its slips land, OP units.
+    pub short: f64,
     /// The healthy hypothesis's loop model.
     pub healthy: LoopModel,
     /// The sticky hypothesis's loop model.
@@ -81,59 +87,96 @@ fn ascend(
 /// Starting processes of the healthy search: time constant and dead time, in samples.
 const STARTS: [(f64, f64); 4] = [(2.0, 1.0), (10.0, 1.0), (10.0, 4.0), (40.0, 4.0)];
 
-/// The best of `best` (likelihood, band) and every band of `bands` under model `m`.
+/// The valves tried: every band at every share of it a slip may land short of OP, share by
+/// share (a share's bands in order, so a band's neighbours on the grid sit beside it).
+struct Grid {
+    slips: Vec<Slip>,
+    bands: usize,
+}
+
+impl Grid {
+    fn new(set: &TestSettings) -> Self {
+        let (a, b) = set.band_range;
+        let bands: Vec<f64> = (0..set.bands)
+            .map(|i| set.op_span * a * (b / a).powf(i as f64 / (set.bands.max(2) - 1) as f64))
+            .collect();
+        let slips = set
+            .short_shares
+            .iter()
+            .flat_map(|&share| {
+                bands.iter().map(move |&band| Slip {
+                    band,
+                    short: share * band,
+                })
+            })
+            .collect();
+        Self {
+            slips,
+            bands: set.bands,
+        }
+    }
+
+    /// `slip` and its neighbours in band at the same share.
+    fn near(&self, slip: Slip) -> &[Slip] {
+        let i = self.slips.iter().position(|&s| s == slip).unwrap_or(0);
+        let row = i / self.bands * self.bands;
+        let lo = i.saturating_sub(1).max(row);
+        let hi = (i + 2).min(row + self.bands);
+        &self.slips[lo..hi]
+    }
+}
+
+/// The best of `best` (likelihood, valve) and every valve of `slips` under model `m`.
 fn scan(
-    sticky: &mut dyn FnMut(&LoopModel, f64) -> f64,
-    bands: &[f64],
+    sticky: &mut dyn FnMut(&LoopModel, Slip) -> f64,
+    slips: &[Slip],
     m: &LoopModel,
-    best: (f64, f64),
-) -> (f64, f64) {
-    bands.iter().fold(best, |b, &d| {
-        let l = sticky(m, d);
+    best: (f64, Slip),
+) -> (f64, Slip) {
+    slips.iter().fold(best, |b, &v| {
+        let l = sticky(m, v);
         if l > b.0 {
-            (l, d)
+            (l, v)
         } else {
             b
         }
     })
 }
 
-/// Coordinate ascent of the sticky likelihood (two sweeps), each move judged at the band and
-/// its neighbours on the grid: another gain or dead time slips the valve at other samples, and
-/// the band that fits moves with them.
+/// Coordinate ascent of the sticky likelihood (two sweeps), each move judged at the valve and
+/// its neighbours in band: another gain or dead time slips the valve at other samples, and the
+/// band that fits moves with them.
 fn ascend_with_band(
-    sticky: &mut dyn FnMut(&LoopModel, f64) -> f64,
-    bands: &[f64],
-    (mut best, mut m, mut band): (f64, LoopModel, f64),
+    sticky: &mut dyn FnMut(&LoopModel, Slip) -> f64,
+    grid: &Grid,
+    (mut best, mut m, mut slip): (f64, LoopModel, Slip),
     coords: &[Coordinate],
     s: &Scales,
-) -> (f64, LoopModel, f64) {
+) -> (f64, LoopModel, Slip) {
     for _ in 0..2 {
         for &c in coords {
             for v in values(c, s) {
                 let mut trial = m;
                 set(&mut trial, c, v);
-                let i = bands.iter().position(|&b| b == band).unwrap_or(0);
-                let near = &bands[i.saturating_sub(1)..(i + 2).min(bands.len())];
-                let (l, d) = scan(sticky, near, &trial, (f64::NEG_INFINITY, band));
+                let (l, d) = scan(sticky, grid.near(slip), &trial, (f64::NEG_INFINITY, slip));
                 if l > best {
-                    (best, m, band) = (l, trial, d);
+                    (best, m, slip) = (l, trial, d);
                 }
             }
         }
     }
-    (best, m, band)
+    (best, m, slip)
 }
 
-/// The sticky hypothesis from a healthy optimum `m`: the bands scanned, the model ascended at the
-/// best (two sweeps), the bands scanned again. Returns the likelihood, model and band.
+/// The sticky hypothesis from a healthy optimum `m`: the valves scanned, the model ascended at
+/// the best (two sweeps), the valves scanned again. Returns the likelihood, model and valve.
 fn sticky_optimum(
-    sticky: &mut dyn FnMut(&LoopModel, f64) -> f64,
+    sticky: &mut dyn FnMut(&LoopModel, Slip) -> f64,
     m: &LoopModel,
-    bands: &[f64],
+    grid: &Grid,
     scales: &Scales,
-) -> (f64, LoopModel, f64) {
-    let (l1, band) = scan(sticky, bands, m, (f64::NEG_INFINITY, bands[0]));
+) -> (f64, LoopModel, Slip) {
+    let (l1, slip) = scan(sticky, &grid.slips, m, (f64::NEG_INFINITY, grid.slips[0]));
     let order = [
         Coordinate::Noise,
         Coordinate::Cycle,
@@ -144,9 +187,9 @@ fn sticky_optimum(
         Coordinate::Delay,
         Coordinate::ValveLag,
     ];
-    let (l1, m1, band) = ascend_with_band(sticky, bands, (l1, *m, band), &order, scales);
-    let (l1, band) = scan(sticky, bands, &m1, (l1, band));
-    (l1, m1, band)
+    let (l1, m1, slip) = ascend_with_band(sticky, grid, (l1, *m, slip), &order, scales);
+    let (l1, slip) = scan(sticky, &grid.slips, &m1, (l1, slip));
+    (l1, m1, slip)
 }
 
 /// The hidden-valve likelihood ratio of a record; `None` on fewer than 50 samples or a flat PV.
@@ -209,22 +252,19 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
         })
         .collect();
     optima.sort_by(|a, b| b.0.total_cmp(&a.0));
-    let bands: Vec<f64> = (0..set.bands)
-        .map(|i| {
-            let (a, b) = set.band_range;
-            let x = i as f64 / (set.bands.max(2) - 1) as f64;
-            set.op_span * a * (b / a).powf(x)
-        })
-        .collect();
-    let mut sticky = |m: &LoopModel, band: f64| {
+    if set.bands == 0 || set.short_shares.is_empty() {
+        return None;
+    }
+    let grid = Grid::new(set);
+    let mut sticky = |m: &LoopModel, slip: Slip| {
         particles += 1;
-        sticky_log_likelihood(rec, m, band, &set.particles)
+        sticky_log_likelihood(rec, m, slip, &set.particles)
     };
-    let (l1, m1, band) = optima
+    let (l1, m1, slip) = optima
         .iter()
         .take(set.sticky_starts.max(1))
-        .map(|(_, m)| sticky_optimum(&mut sticky, m, &bands, &scales))
-        .fold((f64::NEG_INFINITY, start, bands[0]), |a, b| {
+        .map(|(_, m)| sticky_optimum(&mut sticky, m, &grid, &scales))
+        .fold((f64::NEG_INFINITY, start, grid.slips[0]), |a, b| {
             if b.0 > a.0 {
                 b
             } else {
@@ -237,7 +277,8 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
     let (l0, m0) = if h0b.0 > optima[0].0 { h0b } else { optima[0] };
     Some(HiddenValveTest {
         ratio: l1 - l0,
-        band,
+        band: slip.band,
+        short: slip.short,
         healthy: m0,
         sticky: m1,
         evaluations: (kalman, particles),

@@ -1,5 +1,5 @@
 use super::*;
-use crate::models::{Model, Stenman};
+use crate::models::{He, Model, Stenman};
 use crate::sim::{ClosedLoop, Pi, Process};
 
 fn model() -> LoopModel {
@@ -20,7 +20,12 @@ fn model() -> LoopModel {
 
 /// A flow-like loop whose controller runs twice a sample: the record misses half of OP's moves.
 fn record_of(d: f64, samples: usize) -> crate::sim::LoopData {
-    let mut cl = ClosedLoop::new(Model::Stenman(Stenman { d }));
+    record_with(Model::Stenman(Stenman { d }), samples)
+}
+
+/// The same loop with the valve `valve`.
+fn record_with(valve: Model, samples: usize) -> crate::sim::LoopData {
+    let mut cl = ClosedLoop::new(valve);
     cl.process = Process::Foptd {
         k: 1.0,
         tau: 8.0,
@@ -55,7 +60,7 @@ fn a_valve_that_cannot_stick_has_the_healthy_likelihood() {
     let m = model();
     let healthy = healthy_log_likelihood(&rec, &m);
     let pf = Particles { count: 16, seed: 3 };
-    let sticky = sticky_log_likelihood(&rec, &m, 1e-12, &pf);
+    let sticky = sticky_log_likelihood(&rec, &m, Slip::stenman(1e-12), &pf);
     assert!(healthy.is_finite());
     assert!(
         (healthy - sticky).abs() < 1e-6 * healthy.abs(),
@@ -72,8 +77,8 @@ fn the_same_seed_gives_the_same_likelihood() {
         ..model()
     };
     let pf = Particles { count: 32, seed: 9 };
-    let a = sticky_log_likelihood(&rec, &m, 2.0, &pf);
-    let b = sticky_log_likelihood(&rec, &m, 2.0, &pf);
+    let a = sticky_log_likelihood(&rec, &m, Slip::stenman(2.0), &pf);
+    let b = sticky_log_likelihood(&rec, &m, Slip::stenman(2.0), &pf);
     assert_eq!(a.to_bits(), b.to_bits());
 }
 
@@ -102,7 +107,7 @@ fn at_the_true_loop_a_hidden_sticky_valve_explains_pv_and_a_healthy_one_is_not_m
         let data = record_of(d, 600);
         let rec = record(&data, Some((0.0, 100.0)));
         let m = true_model(&data);
-        sticky_log_likelihood(&rec, &m, band, &pf) - healthy_log_likelihood(&rec, &m)
+        sticky_log_likelihood(&rec, &m, Slip::stenman(band), &pf) - healthy_log_likelihood(&rec, &m)
     };
     let sticky = ratio(3.0, 3.0);
     let healthy = ratio(0.0, 3.0);
@@ -130,4 +135,27 @@ fn the_search_finds_a_hidden_sticky_valve_and_no_band_in_a_healthy_one() {
     assert!(sticky.ratio > 20.0, "sticky: {sticky:?}");
     assert!(healthy.ratio < 10.0, "healthy: {healthy:?}");
     assert!(sticky.band > 1.0 && sticky.band < 6.0, "{sticky:?}");
+}
+
+#[test]
+fn a_valve_whose_slips_land_short_of_op_is_heard_as_one() {
+    // He's valve (fs = 3, fd = 1.8): each slip lands 1.8 short of OP. At the true loop the
+    // hidden valve that lands as short explains PV better than Stenman's, which lands on OP
+    let data = record_with(Model::He(He { fs: 3.0, fd: 1.8 }), 600);
+    let rec = record(&data, Some((0.0, 100.0)));
+    let m = true_model(&data);
+    let pf = Particles { count: 64, seed: 5 };
+    let short = sticky_log_likelihood(
+        &rec,
+        &m,
+        Slip {
+            band: 3.0,
+            short: 1.8,
+        },
+        &pf,
+    );
+    let on_op = sticky_log_likelihood(&rec, &m, Slip::stenman(3.0), &pf);
+    let healthy = healthy_log_likelihood(&rec, &m);
+    assert!(short - healthy > 30.0, "{short} against healthy {healthy}");
+    assert!(short - on_op > 100.0, "{short} against Stenman's {on_op}");
 }

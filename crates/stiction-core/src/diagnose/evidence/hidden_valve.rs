@@ -36,16 +36,23 @@ pub const MAX_OP_TRAVEL: f64 = 0.10;
 pub const MAX_UNRECORDED: f64 = 0.05;
 /// Particles of the sticky hypothesis's filter (the calibrated setting).
 pub const PARTICLES: usize = 100;
+/// How far short of OP the hidden valve's slips may land, as shares of its band (0: Stenman's
+/// valve; He's lands `fd` short).
+pub const SHORT_SHARES: &[f64] = &[0.0, 0.35, 0.7];
 
 /// What the hidden-valve test found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HiddenValveEvidence {
     /// Log-likelihood ratio (natural log), a hidden sticky valve against one that follows OP.
     pub ratio: f64,
-    /// The sticky hypothesis's best Stenman band, OP units (a grid of 10 bands, 0.3-8 % of span).
+    /// The sticky hypothesis's best band, OP units (a grid of 10 bands, 0.3-8 % of span, each
+    /// with slips landing on OP or 35 or 70 % of the band short of it).
     pub band: f64,
     /// The same in % of the valve span.
     pub band_percent_of_span: f64,
+    /// How far short of OP its slips land, % of the valve span (0: Stenman's valve, which lands
+    /// on OP; else He's, with `fd` this).
+    pub short_percent_of_span: f64,
     /// Particles of the sticky hypothesis's filter.
     pub particles: usize,
     /// Likelihoods evaluated: Kalman filters (valve following OP), particle filters (hidden
@@ -126,6 +133,7 @@ impl EvidenceFamily for HiddenValve {
                 count: PARTICLES,
                 seed: 1,
             },
+            short_shares: SHORT_SHARES,
             ..TestSettings::default()
         };
         let rec = Record {
@@ -142,14 +150,23 @@ impl EvidenceFamily for HiddenValve {
             ratio: t.ratio,
             band: t.band,
             band_percent_of_span: pct,
+            short_percent_of_span: 100.0 * t.short / (hi - lo),
             particles: PARTICLES,
             evaluations: [t.evaluations.0, t.evaluations.1],
         };
         let sticky = t.ratio >= THRESHOLD;
         let note = if sticky {
+            let lands = if t.short > 0.0 {
+                format!(
+                    ", landing {:.1} % short of OP,",
+                    100.0 * t.short / (hi - lo)
+                )
+            } else {
+                String::new()
+            };
             format!(
-                "PV is far likelier through a hidden valve with a band of {pct:.1} % of span that slips between the samples than through one that follows OP \
-                 (ratio {:.0} against {THRESHOLD:.0})",
+                "PV is far likelier through a hidden valve with a band of {pct:.1} % of span{lands} that slips between the samples than through one \
+                 that follows OP (ratio {:.0} against {THRESHOLD:.0})",
                 t.ratio
             )
         } else {
