@@ -107,7 +107,7 @@ pub struct Columns {
     /// finds more sticky valves in records sampled at every controller execution, 1 to 3 s
     /// a loop of 2,000 samples); where no family has decided stiction on a limit cycle, also the
     /// hidden-valve family (a particle filter over a valve that slips between the samples,
-    /// about 4 to 6 s more)
+    /// about 3 s more on two cores)
     #[arg(long)]
     pub thorough: bool,
     #[command(flatten)]

@@ -86,6 +86,34 @@ fn benches(c: &mut Criterion) {
             b.iter(|| diagnose(black_box(&rec), &req).unwrap())
         });
     }
+    // --thorough where the hidden-valve family runs: a fast loop of the catalogue's calibration
+    // set whose valve slips between the samples (fast-c-0007; the families without it call it
+    // no_stiction), beside the same loop judged by default
+    let l = stiction_core::sim::catalogue::find("fast-c-0007").unwrap();
+    let rec = LoopRecord {
+        op: &l.data.op,
+        pv: &l.data.pv,
+        sp: Some(&l.data.sp),
+        mv: None,
+        time: Some(&l.data.t),
+        auto: None,
+    };
+    for thorough in [false, true] {
+        let req = DiagnoseRequest {
+            ts: l.ts(),
+            quantify: false,
+            thorough,
+            ..DiagnoseRequest::default()
+        };
+        let name = if thorough {
+            "hidden_valve_2000_thorough_without_quantify"
+        } else {
+            "hidden_valve_2000_without_quantify"
+        };
+        g.bench_function(name, |b| {
+            b.iter(|| diagnose(black_box(&rec), &req).unwrap())
+        });
+    }
     g.finish();
 }
 

@@ -36,7 +36,7 @@ pub struct DiagnoseRequest {
     /// Stenman valve scored on PV's levels. Finds more sticky valves on records sampled at every
     /// controller execution, at 1 to 3 s a loop of 2,000 samples. Where the other families have
     /// not decided `stiction`, the hidden-valve family runs too
-    /// ([`super::evidence::hidden_valve`]; 4 to 6 s more where it judges).
+    /// ([`super::evidence::hidden_valve`]; about 3 s more on two cores where it judges).
     #[serde(default)]
     pub thorough: bool,
 }

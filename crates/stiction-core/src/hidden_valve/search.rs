@@ -5,6 +5,8 @@ use super::coordinates::{
 };
 use super::likelihood::{healthy_log_likelihood, sticky_log_likelihood, Particles, Record, Slip};
 use super::model::LoopModel;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// How the test searches.
 #[derive(Debug, Clone, Copy)]
@@ -233,14 +235,16 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
         input_noise: set.input_noise * step_noise(rec.op),
     };
     let all: Vec<Coordinate> = PROCESS.iter().chain(&LOADS).copied().collect();
-    let (mut kalman, mut particles) = (0, 0);
-    let mut healthy = |m: &LoopModel| {
-        kalman += 1;
+    // the starts are searched in parallel: every evaluation is a deterministic function of its
+    // model (the particle filter's seed is fixed), so the result does not depend on the threads
+    let (kalman, particles) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    let healthy = |m: &LoopModel| {
+        kalman.fetch_add(1, Ordering::Relaxed);
         healthy_log_likelihood(rec, m)
     };
     // the healthy likelihood has several optima: ascend from a few processes, keep the two best
     let mut optima: Vec<(f64, LoopModel)> = STARTS
-        .iter()
+        .par_iter()
         .map(|&(tau, delay)| {
             let m = LoopModel {
                 tau: tau * rec.ts,
@@ -248,7 +252,7 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
                 ..start
             };
             let first = healthy(&m);
-            ascend(&mut healthy, (first, m), &all, 3, &scales)
+            ascend(&mut &healthy, (first, m), &all, 3, &scales)
         })
         .collect();
     optima.sort_by(|a, b| b.0.total_cmp(&a.0));
@@ -256,31 +260,35 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
         return None;
     }
     let grid = Grid::new(set);
-    let mut sticky = |m: &LoopModel, slip: Slip| {
-        particles += 1;
+    let sticky = |m: &LoopModel, slip: Slip| {
+        particles.fetch_add(1, Ordering::Relaxed);
         sticky_log_likelihood(rec, m, slip, &set.particles)
     };
-    let (l1, m1, slip) = optima
-        .iter()
-        .take(set.sticky_starts.max(1))
-        .map(|(_, m)| sticky_optimum(&mut sticky, m, &grid, &scales))
-        .fold((f64::NEG_INFINITY, start, grid.slips[0]), |a, b| {
-            if b.0 > a.0 {
-                b
-            } else {
-                a
-            }
-        });
+    let searched: Vec<(f64, LoopModel, Slip)> = optima[..set.sticky_starts.clamp(1, optima.len())]
+        .par_iter()
+        .map(|(_, m)| sticky_optimum(&mut &sticky, m, &grid, &scales))
+        .collect();
+    let (l1, m1, slip) =
+        searched
+            .into_iter()
+            .fold((f64::NEG_INFINITY, start, grid.slips[0]), |a, b| {
+                if b.0 > a.0 {
+                    b
+                } else {
+                    a
+                }
+            });
     // the healthy hypothesis searched again from the sticky one's model
     let again = healthy(&m1);
-    let h0b = ascend(&mut healthy, (again, m1), &all, 2, &scales);
+    let h0b = ascend(&mut &healthy, (again, m1), &all, 2, &scales);
     let (l0, m0) = if h0b.0 > optima[0].0 { h0b } else { optima[0] };
+    let evaluations = (kalman.into_inner(), particles.into_inner());
     Some(HiddenValveTest {
         ratio: l1 - l0,
         band: slip.band,
         short: slip.short,
         healthy: m0,
         sticky: m1,
-        evaluations: (kalman, particles),
+        evaluations,
     })
 }

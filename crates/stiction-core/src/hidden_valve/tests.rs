@@ -159,3 +159,23 @@ fn a_valve_whose_slips_land_short_of_op_is_heard_as_one() {
     assert!(short - healthy > 30.0, "{short} against healthy {healthy}");
     assert!(short - on_op > 100.0, "{short} against Stenman's {on_op}");
 }
+
+#[test]
+fn the_search_gives_the_same_result_on_any_number_of_threads() {
+    let settings = TestSettings {
+        particles: Particles { count: 16, seed: 1 },
+        bands: 4,
+        short_shares: &[0.0, 0.5],
+        ..TestSettings::default()
+    };
+    let data = record_of(3.0, 300);
+    let rec = record(&data, Some((0.0, 100.0)));
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| test(&rec, &settings).unwrap())
+    };
+    assert_eq!(on(1), on(3));
+}

@@ -80,7 +80,7 @@ def diagnose(
         on PV's levels): more sticky valves found on records sampled at every controller
         execution, at 1 to 3 s a loop of 2,000 samples; where no family has decided stiction on
         a limit cycle, also the hidden-valve family (a particle filter over a valve that slips
-        between the samples; 4 to 6 s more).
+        between the samples; about 3 s more on two cores).
 
     Missing values (NaN, None, historian states such as "Bad Input") are gaps.
     """
