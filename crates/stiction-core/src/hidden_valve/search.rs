@@ -6,6 +6,7 @@ use super::coordinates::{
 use super::likelihood::{healthy_log_likelihood, sticky_log_likelihood, Particles, Record, Slip};
 use super::model::LoopModel;
 use rayon::prelude::*;
+use std::collections::HashMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// How the test searches.
@@ -61,6 +62,33 @@ pub struct HiddenValveTest {
     pub sticky: LoopModel,
     /// Likelihood evaluations: Kalman filters, particle filters.
     pub evaluations: (usize, usize),
+}
+
+/// A model's parameters, bit for bit: the key under which a likelihood is remembered.
+fn key(m: &LoopModel) -> [u64; 10] {
+    [
+        m.gain,
+        m.tau,
+        m.delay,
+        m.valve_lag,
+        m.noise,
+        m.drift,
+        m.cycle,
+        m.cycle_radius,
+        m.cycle_angle,
+        m.input_noise,
+    ]
+    .map(f64::to_bits)
+}
+
+/// `f` remembered: the ascents come back to models (and valves) they have judged, each
+/// coordinate's grid holding the current value; a remembered likelihood is the same number.
+fn remembered<K: std::hash::Hash + Eq, A: Copy>(
+    f: impl Fn(&LoopModel, A) -> f64,
+    with: impl Fn(A) -> K,
+) -> impl FnMut(&LoopModel, A) -> f64 {
+    let mut seen: HashMap<([u64; 10], K), f64> = HashMap::new();
+    move |m, a| *seen.entry((key(m), with(a))).or_insert_with(|| f(m, a))
 }
 
 /// Coordinate ascent of `f` from `(best, m)` over `coords`, `sweeps` times.
@@ -251,8 +279,9 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
                 delay: delay * rec.ts,
                 ..start
             };
-            let first = healthy(&m);
-            ascend(&mut &healthy, (first, m), &all, 3, &scales)
+            let mut f = remembered(|m, ()| healthy(m), |()| ());
+            let first = f(&m, ());
+            ascend(&mut |m| f(m, ()), (first, m), &all, 3, &scales)
         })
         .collect();
     optima.sort_by(|a, b| b.0.total_cmp(&a.0));
@@ -266,7 +295,10 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
     };
     let searched: Vec<(f64, LoopModel, Slip)> = optima[..set.sticky_starts.clamp(1, optima.len())]
         .par_iter()
-        .map(|(_, m)| sticky_optimum(&mut &sticky, m, &grid, &scales))
+        .map(|(_, m)| {
+            let mut f = remembered(&sticky, |s: Slip| (s.band.to_bits(), s.short.to_bits()));
+            sticky_optimum(&mut f, m, &grid, &scales)
+        })
         .collect();
     let (l1, m1, slip) =
         searched
@@ -279,9 +311,11 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
                 }
             });
     // the healthy hypothesis searched again from the sticky one's model
-    let again = healthy(&m1);
-    let h0b = ascend(&mut &healthy, (again, m1), &all, 2, &scales);
+    let mut f = remembered(|m, ()| healthy(m), |()| ());
+    let again = f(&m1, ());
+    let h0b = ascend(&mut |m| f(m, ()), (again, m1), &all, 2, &scales);
     let (l0, m0) = if h0b.0 > optima[0].0 { h0b } else { optima[0] };
+    drop(f);
     let evaluations = (kalman.into_inner(), particles.into_inner());
     Some(HiddenValveTest {
         ratio: l1 - l0,
