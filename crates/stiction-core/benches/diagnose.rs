@@ -1,4 +1,7 @@
 //! Diagnosis benchmarks. Run: cargo bench -p stiction-core --bench diagnose
+#[path = "../examples/common/catalogue_loop.rs"]
+mod catalogue_loop;
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use stiction_core::diagnose::{diagnose, DiagnoseRequest, LoopRecord};
@@ -90,20 +93,12 @@ fn benches(c: &mut Criterion) {
     // set whose valve slips between the samples (fast-c-0007; the families without it call it
     // no_stiction), beside the same loop judged by default
     let l = stiction_core::sim::catalogue::find("fast-c-0007").unwrap();
-    let rec = LoopRecord {
-        op: &l.data.op,
-        pv: &l.data.pv,
-        sp: Some(&l.data.sp),
-        mv: None,
-        time: Some(&l.data.t),
-        auto: None,
-    };
+    let rec = catalogue_loop::record(&l);
     for thorough in [false, true] {
         let req = DiagnoseRequest {
-            ts: l.ts(),
             quantify: false,
             thorough,
-            ..DiagnoseRequest::default()
+            ..catalogue_loop::request(&l)
         };
         let name = if thorough {
             "hidden_valve_2000_thorough_without_quantify"

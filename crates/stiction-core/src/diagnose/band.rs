@@ -240,14 +240,8 @@ pub(super) fn size(
             band.others.push((BandSource::Levels, pct(l)));
         }
     }
-    // the hidden valve decided the verdict: the fits read the recorded OP as the valve's input,
-    // which is what it showed wrong; its band is reported (the recorded valve's still first)
-    match hidden {
-        Some(h) if band.source == BandSource::Valve => {
-            band.others.push((BandSource::HiddenValve, pct(h)))
-        }
-        Some(h) => replace(&mut band, h, BandSource::HiddenValve, req),
-        None => {}
+    if let Some(h) = hidden {
+        hidden_valve_band(&mut band, h, req);
     }
     unresolved(d, &mut band, stand_in, op_noise, req);
     if let Some(t) = stick.filter(|_| band.source != BandSource::StickSlip) {
@@ -314,6 +308,18 @@ fn unresolved(
         source.words()
     ));
     replace(band, by, source, req);
+}
+
+/// The hidden valve decided the verdict: the fits read the recorded OP as the valve's input,
+/// which is what it showed wrong, so its band `h` (OP units) is reported; the recorded valve's
+/// still comes first.
+fn hidden_valve_band(band: &mut Band, h: f64, req: &DiagnoseRequest) {
+    if band.source == BandSource::Valve {
+        band.others
+            .push((BandSource::HiddenValve, req.percent_of_span(h)));
+    } else {
+        replace(band, h, BandSource::HiddenValve, req);
+    }
 }
 
 /// Report `by` (OP units, from `source`) instead of `band`, the replaced estimate beside it (with

@@ -17,6 +17,7 @@
 //! `docs/hidden-valve-routine.md`) set where it holds; `diagnose --thorough` runs it there as the
 //! hidden-valve family ([`crate::diagnose::evidence::hidden_valve`]).
 
+mod ascent;
 mod coordinates;
 mod likelihood;
 mod model;
