@@ -12,6 +12,7 @@
 //! not at all: a sticky valve's ratio can be small, so a small ratio is no evidence against it.
 
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
+use crate::diagnose::oscillation::amplitude;
 use crate::diagnose::result::Vote;
 use crate::hidden_valve::{test, Particles, Record, TestSettings};
 use serde::{Deserialize, Serialize};
@@ -25,10 +26,10 @@ pub struct HiddenValve;
 /// a load drift), rounded up to 5. The benchmark sets were judged at it after
 /// (docs/plant-benchmark-thorough.md).
 pub const THRESHOLD: f64 = 60.0;
-/// OP's travel (5th to 95th percentile) above this share of the valve span leaves the family
-/// silent: on the routine calibration windows an equal-percentage valve under a load ramp (OP over
-/// 14 % of span) reached a ratio of 288; the sticky valves the family found moved OP over at most
-/// 6.5 %.
+/// OP's travel (5th to 95th percentile, twice its amplitude) above this share of the valve span
+/// leaves the family silent: on the routine calibration windows an equal-percentage valve under a
+/// load ramp (OP over 14 % of span) reached a ratio of 288; the sticky valves the family found
+/// moved OP over at most 6.5 %.
 pub const MAX_OP_TRAVEL: f64 = 0.10;
 /// PV samples not recorded (runs of repeats or exactly straight lines) above this share leave the
 /// family silent: a held or straight-lined PV is no Gaussian measurement, and compressed records
@@ -81,14 +82,6 @@ pub fn not_needed() -> FamilyEvidence {
     )
 }
 
-/// OP's travel, 5th to 95th percentile, OP units.
-fn travel(op: &[f64]) -> f64 {
-    let mut v = op.to_vec();
-    v.sort_by(f64::total_cmp);
-    let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-    at(0.95) - at(0.05)
-}
-
 /// Why the family cannot judge this record, if it cannot.
 fn gated(ctx: &Context) -> Option<String> {
     let [lo, hi] = ctx.req.op_range;
@@ -103,7 +96,7 @@ fn gated(ctx: &Context) -> Option<String> {
         ))
     } else if ctx.pv_quantum.is_some() {
         Some("PV is quantised: no Gaussian measurement".into())
-    } else if ctx.op.is_empty() || travel(ctx.op) > MAX_OP_TRAVEL * (hi - lo) {
+    } else if ctx.op.is_empty() || 2.0 * amplitude(ctx.op) > MAX_OP_TRAVEL * (hi - lo) {
         Some(format!(
             "OP travels over more than {:.0} % of span, where a valve's characteristic is not linear",
             100.0 * MAX_OP_TRAVEL
