@@ -18,6 +18,7 @@ mod catalogue_loop;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::time::Instant;
+use stiction_core::diagnose::evidence::hidden_valve::PARTICLES;
 use stiction_core::diagnose::{diagnose, Verdict};
 use stiction_core::hidden_valve::{test, Particles, Record, TestSettings};
 use stiction_core::sim::catalogue::{catalogue, BenchmarkLoop, Set, Suite, Truth};
@@ -87,7 +88,7 @@ fn main() {
         _ => Suite::Fast,
     };
     let particles: usize =
-        arg(&args, "--particles").map_or(100, |v| v.parse().expect("--particles N"));
+        arg(&args, "--particles").map_or(PARTICLES, |v| v.parse().expect("--particles N"));
     let sticky_starts: usize =
         arg(&args, "--sticky-starts").map_or(2, |v| v.parse().expect("--sticky-starts N"));
     let only: Vec<&String> = args

@@ -138,15 +138,52 @@ pub(super) fn ascend_with_band(
     (best, m, slip)
 }
 
-/// The sticky hypothesis from a healthy optimum `m`: the valves scanned, the model ascended at
-/// the best (two sweeps), the valves scanned again. Returns the likelihood, model and valve.
-pub(super) fn sticky_optimum(
+/// The valves the sticky ascents start from at a healthy optimum `m`: the scan's best and, with
+/// `basins` 2, the best whose band lies more than a grid step from it. At a healthy optimum,
+/// whose model has absorbed part of a sticky valve's effect, a small band can beat the true one
+/// until the model moves, and an ascent that moves a band a step at a time stays by it.
+pub(super) fn band_starts(
     sticky: &mut dyn FnMut(&LoopModel, Slip) -> f64,
     m: &LoopModel,
     grid: &Grid,
+    basins: usize,
+) -> Vec<(f64, Slip)> {
+    let scored: Vec<(usize, f64)> = (0..grid.slips.len())
+        .map(|i| (i, sticky(m, grid.slips[i])))
+        .collect();
+    let best_of = |keep: &dyn Fn(usize) -> bool| {
+        scored
+            .iter()
+            .filter(|(i, _)| keep(*i))
+            .fold(None, |b: Option<(usize, f64)>, &(i, l)| match b {
+                Some((_, bl)) if bl >= l => b,
+                _ => Some((i, l)),
+            })
+    };
+    let Some((first, l)) = best_of(&|_| true) else {
+        return Vec::new();
+    };
+    let mut starts = vec![(l, grid.slips[first])];
+    let band = |i: usize| i % grid.bands;
+    if basins > 1 {
+        if let Some((j, l)) = best_of(&|i| band(i).abs_diff(band(first)) > 1) {
+            starts.push((l, grid.slips[j]));
+        }
+    }
+    starts
+}
+
+/// The sticky hypothesis from a healthy optimum `m` and a valve `start` of the scan there: the
+/// model ascended with the valve (two sweeps), the valves scanned again. Returns the likelihood,
+/// model and valve.
+pub(super) fn sticky_optimum(
+    sticky: &mut dyn FnMut(&LoopModel, Slip) -> f64,
+    m: &LoopModel,
+    start: (f64, Slip),
+    grid: &Grid,
     scales: &Scales,
 ) -> (f64, LoopModel, Slip) {
-    let (l1, slip) = scan(sticky, &grid.slips, m, (f64::NEG_INFINITY, grid.slips[0]));
+    let (l1, slip) = start;
     let order = [
         Coordinate::Noise,
         Coordinate::Cycle,

@@ -3,8 +3,9 @@
 //! valve, each particle's loop state filtered exactly: Rao-Blackwellised).
 
 use super::model::{innovation, log_density, predict, update, Gains, LoopModel, STATES};
-use crate::rng::{gaussian, seeded};
+use crate::rng::seeded;
 use rand::RngExt;
+use rand_distr::StandardNormal;
 
 /// What both likelihoods read: the record, its sampling time and the valve's travel limits.
 #[derive(Debug, Clone, Copy)]
@@ -57,9 +58,9 @@ pub fn healthy_log_likelihood(rec: &Record, m: &LoopModel) -> f64 {
     for t in 0..rec.pv.len() {
         let u = rec.clip(rec.op[t.saturating_sub(k)]);
         predict(&mat.f, mat.b[0], &mut mean, u);
-        let (g, s) = gains.at(t);
+        let (g, s, log_s) = gains.at(t);
         let e = innovation(&mean, rec.pv[t]);
-        ll += log_density(e, s);
+        ll += log_density(e, s, log_s);
         update(&mut mean, g, e);
     }
     ll
@@ -130,12 +131,13 @@ pub fn sticky_log_likelihood(rec: &Record, m: &LoopModel, slip: Slip, pf: &Parti
         Vec::with_capacity(ring.len()),
     );
     for t in 0..rec.pv.len() {
-        let (g, s) = gains.at(t);
-        // the log density's constant, shared by every particle at this step
-        let log_s = (std::f64::consts::TAU * s).ln();
+        // the log density's constant is shared by every particle at this step
+        let (g, s, log_s) = gains.at(t);
         let slot = t % (k + 1);
         for i in 0..n {
-            let seen = rec.op[t] + m.input_noise * gaussian(&mut rng);
+            // a ziggurat draw: the particles' draws were half the filter's time by Box-Muller
+            let z: f64 = rng.sample(StandardNormal);
+            let seen = rec.op[t] + m.input_noise * z;
             let gap = seen - valve[i];
             if gap.abs() > band {
                 // short = 0 lands on OP exactly (seen - ±0)
@@ -149,7 +151,7 @@ pub fn sticky_log_likelihood(rec: &Record, m: &LoopModel, slip: Slip, pf: &Parti
             let mean = &mut means[i];
             predict(&mat.f, mat.b[0], mean, u);
             let e = innovation(mean, rec.pv[t]);
-            log_w[i] += -0.5 * (log_s + e * e / s);
+            log_w[i] += log_density(e, s, log_s);
             update(mean, g, e);
         }
         let top = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);

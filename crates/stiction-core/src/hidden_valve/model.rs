@@ -87,6 +87,8 @@ pub(super) const H: [f64; STATES] = [0.0, 1.0, 1.0, 1.0, 0.0];
 pub(super) struct Gains {
     pub gain: Vec<[f64; STATES]>,
     pub variance: Vec<f64>,
+    /// `ln(2 pi variance)`, the log density's constant, once a stored step.
+    pub log_variance: Vec<f64>,
 }
 
 impl Gains {
@@ -134,13 +136,21 @@ impl Gains {
                 break;
             }
         }
-        Self { gain, variance }
+        let log_variance = variance
+            .iter()
+            .map(|s| (std::f64::consts::TAU * s).ln())
+            .collect();
+        Self {
+            gain,
+            variance,
+            log_variance,
+        }
     }
 
-    /// The gain and innovation variance at step `t`.
-    pub fn at(&self, t: usize) -> (&[f64; STATES], f64) {
+    /// The gain, innovation variance and the log density's constant at step `t`.
+    pub fn at(&self, t: usize) -> (&[f64; STATES], f64, f64) {
         let i = t.min(self.gain.len() - 1);
-        (&self.gain[i], self.variance[i])
+        (&self.gain[i], self.variance[i], self.log_variance[i])
     }
 }
 
@@ -180,8 +190,9 @@ pub(super) fn update(m: &mut [f64; STATES], k: &[f64; STATES], e: f64) {
     }
 }
 
-/// The log density of a Gaussian innovation `e` of variance `s`.
+/// The log density of a Gaussian innovation `e` of variance `s`, `log_s` its constant
+/// `ln(2 pi s)`.
 #[inline]
-pub(super) fn log_density(e: f64, s: f64) -> f64 {
-    -0.5 * ((std::f64::consts::TAU * s).ln() + e * e / s)
+pub(super) fn log_density(e: f64, s: f64, log_s: f64) -> f64 {
+    -0.5 * (log_s + e * e / s)
 }

@@ -1,6 +1,6 @@
 //! The likelihood ratio with each hypothesis's loop model found by coordinate ascent.
 
-use super::ascent::{ascend, remembered, sticky_optimum, Grid};
+use super::ascent::{ascend, band_starts, remembered, sticky_optimum, Grid};
 use super::coordinates::{cycle_angle, gain_sign, step_noise, Coordinate, Scales, LOADS, PROCESS};
 use super::likelihood::{healthy_log_likelihood, sticky_log_likelihood, Particles, Record, Slip};
 use super::model::LoopModel;
@@ -28,6 +28,9 @@ pub struct TestSettings {
     /// How far short of OP a slip may land, as shares of the band, each tried with every band
     /// (`[0.0]`: Stenman's valve alone; He's valve lands `fd` short of OP).
     pub short_shares: &'static [f64],
+    /// Valves each sticky search starts from at its healthy optimum: 1, the scan's best; 2, also
+    /// the best whose band lies more than a grid step from it (another basin).
+    pub band_starts: usize,
 }
 
 impl Default for TestSettings {
@@ -41,6 +44,7 @@ impl Default for TestSettings {
             particles: Particles::default(),
             sticky_starts: 2,
             short_shares: &[0.0],
+            band_starts: 1,
         }
     }
 }
@@ -136,11 +140,16 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
         particles.fetch_add(1, Ordering::Relaxed);
         sticky_log_likelihood(rec, m, slip, &set.particles)
     };
+    // from each healthy optimum, an ascent from each of its valves to start from (one memory of
+    // likelihoods for them all)
     let searched: Vec<(f64, LoopModel, Slip)> = optima[..set.sticky_starts.clamp(1, optima.len())]
         .par_iter()
-        .map(|(_, m)| {
+        .flat_map_iter(|(_, m)| {
             let mut f = remembered(&sticky, |s: Slip| (s.band.to_bits(), s.short.to_bits()));
-            sticky_optimum(&mut f, m, &grid, &scales)
+            band_starts(&mut f, m, &grid, set.band_starts)
+                .into_iter()
+                .map(|start| sticky_optimum(&mut f, m, start, &grid, &scales))
+                .collect::<Vec<_>>()
         })
         .collect();
     let (l1, m1, slip) =

@@ -120,21 +120,33 @@ fn at_the_true_loop_a_hidden_sticky_valve_explains_pv_and_a_healthy_one_is_not_m
 
 #[test]
 fn the_search_finds_a_hidden_sticky_valve_and_no_band_in_a_healthy_one() {
-    let settings = TestSettings {
-        particles: Particles { count: 32, seed: 1 },
-        bands: 6,
-        ..TestSettings::default()
+    // the particle filter's draws move the greedy search's path: from the scan's best valve
+    // alone the search stays at a small band near the healthy optimum on one seed of four
+    // (ratio 1.5; the others 33 to 59); started from a band away too, it finds the band on
+    // every seed, and the healthy record gives no band on any
+    let (sticky_data, healthy_data) = (record_of(3.0, 800), record_of(0.0, 800));
+    let found = |band_starts: usize| {
+        (1..=4)
+            .filter(|&seed| {
+                let settings = TestSettings {
+                    particles: Particles { count: 50, seed },
+                    bands: 6,
+                    band_starts,
+                    ..TestSettings::default()
+                };
+                let healthy = test(&record(&healthy_data, Some((0.0, 100.0))), &settings).unwrap();
+                assert!(healthy.ratio < 10.0, "healthy, seed {seed}: {healthy:?}");
+                let sticky = test(&record(&sticky_data, Some((0.0, 100.0))), &settings).unwrap();
+                sticky.ratio > 20.0 && sticky.band > 1.0 && sticky.band < 6.0
+            })
+            .count()
     };
-    let ratio = |d: f64| {
-        let data = record_of(d, 400);
-        let rec = record(&data, Some((0.0, 100.0)));
-        test(&rec, &settings).unwrap()
-    };
-    let sticky = ratio(3.0);
-    let healthy = ratio(0.0);
-    assert!(sticky.ratio > 20.0, "sticky: {sticky:?}");
-    assert!(healthy.ratio < 10.0, "healthy: {healthy:?}");
-    assert!(sticky.band > 1.0 && sticky.band < 6.0, "{sticky:?}");
+    let (one, two) = (found(1), found(2));
+    assert_eq!(two, 4, "started from two bands");
+    assert!(
+        one <= two,
+        "the scan's best alone found it on {one} seeds, both on {two}"
+    );
 }
 
 #[test]
