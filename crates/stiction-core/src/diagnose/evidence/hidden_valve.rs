@@ -14,7 +14,7 @@
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
 use crate::diagnose::oscillation::amplitude;
 use crate::diagnose::result::Vote;
-use crate::hidden_valve::{test, Particles, Record, TestSettings};
+use crate::hidden_valve::{test, HiddenValveTest, Particles, Record, TestSettings};
 use serde::{Deserialize, Serialize};
 
 /// The hidden-valve family.
@@ -44,6 +44,15 @@ pub const PARTICLES: usize = 50;
 /// three of four seeds of ISDB loop PAP2 (ratios near -12; the fourth 182), with both every seed
 /// found a ratio of 149 to 179.
 pub const BAND_STARTS: usize = 2;
+/// Draws of the particle filter's noise (seeds 1, 2, ...) whose median ratio decides a stiction
+/// vote: a ratio at or above the threshold is drawn again with other seeds. On the 249 loops the
+/// family judged on the four plant-benchmark sets, one draw against another moved 12 votes
+/// (the ratio's spread over three draws: median 2, 90th percentile 20, largest 102); a
+/// look-alike reached 74 and another 103 with other draws than the first, and their medians are
+/// 46 and 10. The median of three kept every look-alike of the calibration sets under 60 (58.2
+/// and 46.2) and no sticky loop whose first draw alone passed with the other two far under it
+/// (fast-c-0026: 103, then 5 and 3).
+pub const DRAWS: u64 = 3;
 /// How far short of OP the hidden valve's slips may land, as shares of its band (0: Stenman's
 /// valve; He's lands `fd` short).
 pub const SHORT_SHARES: &[f64] = &[0.0, 0.35, 0.7];
@@ -61,6 +70,9 @@ pub struct HiddenValveEvidence {
     /// How far short of OP its slips land, % of the valve span (0: Stenman's valve, which lands
     /// on OP; else He's, with `fd` this).
     pub short_percent_of_span: f64,
+    /// The ratio of each draw of the particle filter's noise, in the order of their seeds: one
+    /// when the first is under the threshold, else [`DRAWS`], whose median is `ratio`.
+    pub draws: Vec<f64>,
     /// Particles of the sticky hypothesis's filter.
     pub particles: usize,
     /// Likelihoods evaluated: Kalman filters (valve following OP), particle filters (hidden
@@ -73,7 +85,8 @@ const STATISTIC: &str =
 
 fn threshold() -> String {
     format!(
-        "stiction at a ratio of {THRESHOLD:.0} or more (above every look-alike of the calibration sets); below it, no vote \
+        "stiction at a ratio of {THRESHOLD:.0} or more (above every look-alike of the calibration sets; a first ratio that reaches it \
+         is drawn {DRAWS} times in all with the particle filter's noise and the median decides); below it, no vote \
          (a sticky valve's ratio can be small). Judged only on an oscillating loop with PV recorded and OP within {:.0} % of span",
         100.0 * MAX_OP_TRAVEL
     )
@@ -126,55 +139,26 @@ impl EvidenceFamily for HiddenValve {
             return abstain(why);
         }
         let [lo, hi] = ctx.req.op_range;
-        let settings = TestSettings {
-            op_span: hi - lo,
-            integrating: ctx.req.integrating,
-            particles: Particles {
-                count: PARTICLES,
-                seed: 1,
-            },
-            short_shares: SHORT_SHARES,
-            band_starts: BAND_STARTS,
-            ..TestSettings::default()
-        };
         let rec = Record {
             op: ctx.op,
             pv: ctx.pv,
             ts: ctx.req.ts,
             limits: Some((lo, hi)),
         };
-        let Some(t) = test(&rec, &settings) else {
+        let Some((t, draws, evaluations)) = drawn(&rec, hi - lo, ctx.req.integrating) else {
             return abstain("PV does not move above its resolution: nothing to filter".into());
         };
         let pct = 100.0 * t.band / (hi - lo);
+        let sticky = t.ratio >= THRESHOLD;
+        let note = note(&t, &draws, hi - lo);
         let evidence = HiddenValveEvidence {
             ratio: t.ratio,
             band: t.band,
             band_percent_of_span: pct,
             short_percent_of_span: 100.0 * t.short / (hi - lo),
+            draws,
             particles: PARTICLES,
-            evaluations: [t.evaluations.0, t.evaluations.1],
-        };
-        let sticky = t.ratio >= THRESHOLD;
-        let note = if sticky {
-            let lands = if t.short > 0.0 {
-                format!(
-                    ", landing {:.1} % short of OP,",
-                    100.0 * t.short / (hi - lo)
-                )
-            } else {
-                String::new()
-            };
-            format!(
-                "PV is far likelier through a hidden valve with a band of {pct:.1} % of span{lands} that slips between the samples than through one \
-                 that follows OP (ratio {:.0} against {THRESHOLD:.0})",
-                t.ratio
-            )
-        } else {
-            format!(
-                "a hidden sticky valve explains PV no better than the threshold asks (ratio {:.1} against {THRESHOLD:.0})",
-                t.ratio
-            )
+            evaluations,
         };
         FamilyEvidence {
             vote: if sticky {
@@ -187,5 +171,75 @@ impl EvidenceFamily for HiddenValve {
             hidden_valve: Some(evidence),
             ..abstain(note)
         }
+    }
+}
+
+/// The test with the first draw of the particle filter's noise, and where its ratio reaches the
+/// threshold, with [`DRAWS`] in all (in parallel): the median draw's test, every draw's ratio in
+/// seed order, and the likelihoods evaluated by all of them.
+fn drawn(
+    rec: &Record,
+    op_span: f64,
+    integrating: bool,
+) -> Option<(HiddenValveTest, Vec<f64>, [usize; 2])> {
+    let run = |seed: u64| {
+        let settings = TestSettings {
+            op_span,
+            integrating,
+            particles: Particles {
+                count: PARTICLES,
+                seed,
+            },
+            short_shares: SHORT_SHARES,
+            band_starts: BAND_STARTS,
+            ..TestSettings::default()
+        };
+        test(rec, &settings)
+    };
+    let first = run(1)?;
+    let mut tests = vec![first];
+    if tests[0].ratio >= THRESHOLD {
+        use rayon::prelude::*;
+        let more: Vec<HiddenValveTest> = (2..=DRAWS).into_par_iter().filter_map(run).collect();
+        tests.extend(more);
+    }
+    let draws: Vec<f64> = tests.iter().map(|t| t.ratio).collect();
+    let evaluations = tests.iter().fold([0, 0], |[k, p], t| {
+        [k + t.evaluations.0, p + t.evaluations.1]
+    });
+    tests.sort_by(|a, b| a.ratio.total_cmp(&b.ratio));
+    let median = tests.swap_remove(tests.len() / 2);
+    Some((median, draws, evaluations))
+}
+
+/// The family's note on the (median) test `t` and the draws' ratios.
+fn note(t: &HiddenValveTest, draws: &[f64], op_span: f64) -> String {
+    let of_draws = if draws.len() > 1 {
+        let each: Vec<String> = draws.iter().map(|r| format!("{r:.0}")).collect();
+        format!(
+            ", the median of {} draws of the particle filter's noise: {}",
+            draws.len(),
+            each.join(", ")
+        )
+    } else {
+        String::new()
+    };
+    if t.ratio >= THRESHOLD {
+        let lands = if t.short > 0.0 {
+            format!(", landing {:.1} % short of OP,", 100.0 * t.short / op_span)
+        } else {
+            String::new()
+        };
+        format!(
+            "PV is far likelier through a hidden valve with a band of {:.1} % of span{lands} that slips between the samples than through one \
+             that follows OP (ratio {:.0} against {THRESHOLD:.0}{of_draws})",
+            100.0 * t.band / op_span,
+            t.ratio
+        )
+    } else {
+        format!(
+            "a hidden sticky valve explains PV no better than the threshold asks (ratio {:.1} against {THRESHOLD:.0}{of_draws})",
+            t.ratio
+        )
     }
 }
