@@ -301,16 +301,22 @@ fn an_oscillation_that_op_does_not_drive_is_not_stiction() {
     assert!(d.band.is_none());
 }
 
-/// A catalogue loop judged as `plant_benchmark` judges it (its sampling time and process type,
-/// the defaults otherwise).
+/// A family's evidence in a diagnosis.
+fn family_of(
+    d: &stiction_core::diagnose::Diagnosis,
+    family: Family,
+) -> &stiction_core::diagnose::evidence::FamilyEvidence {
+    d.families
+        .iter()
+        .find(|f| f.family == family)
+        .unwrap_or_else(|| panic!("no {family:?} family in the diagnosis"))
+}
+
 /// The model family's evidence in a diagnosis.
 fn model_family(
     d: &stiction_core::diagnose::Diagnosis,
 ) -> &stiction_core::diagnose::evidence::FamilyEvidence {
-    d.families
-        .iter()
-        .find(|f| f.family == Family::Model)
-        .expect("every diagnosis has a model family")
+    family_of(d, Family::Model)
 }
 
 pub(crate) fn judge_catalogue(id: &str) -> stiction_core::diagnose::Diagnosis {
@@ -610,6 +616,13 @@ fn a_levels_stick_slip_episodes_are_judged_on_the_level_itself() {
     );
 }
 
+/// The hidden-valve family's evidence of a thorough diagnosis.
+fn hidden_valve_of(
+    d: &stiction_core::diagnose::Diagnosis,
+) -> &stiction_core::diagnose::evidence::FamilyEvidence {
+    family_of(d, Family::HiddenValve)
+}
+
 #[test]
 fn thorough_finds_a_valve_that_slips_between_the_samples() {
     // fast-c-0007 of the catalogue's calibration set: a flow loop recorded every 3 s whose
@@ -622,11 +635,7 @@ fn thorough_finds_a_valve_that_slips_between_the_samples() {
         .families
         .iter()
         .all(|f| f.family != Family::HiddenValve));
-    let hidden = d
-        .families
-        .iter()
-        .find(|f| f.family == Family::HiddenValve)
-        .unwrap();
+    let hidden = hidden_valve_of(&d);
     assert_eq!(hidden.vote, Vote::Stiction, "{}", hidden.note);
     let h = hidden.hidden_valve.as_ref().unwrap();
     assert!(
@@ -656,13 +665,7 @@ fn thorough_runs_the_hidden_valve_only_where_it_can_judge_and_change_the_verdict
         thorough: true,
         ..DiagnoseRequest::default()
     };
-    let hidden = |d: &stiction_core::diagnose::Diagnosis| {
-        d.families
-            .iter()
-            .find(|f| f.family == Family::HiddenValve)
-            .cloned()
-            .unwrap()
-    };
+    let hidden = |d: &stiction_core::diagnose::Diagnosis| hidden_valve_of(d).clone();
     // a healthy valve under noise alone: no oscillation, no judgement
     let calm = run(0.0, |_| {});
     let d = diagnose(&record(&calm), &thorough).unwrap();
@@ -691,11 +694,7 @@ fn a_hidden_valve_ratio_under_the_threshold_is_drawn_once() {
     };
     let d = diagnose(&record(&l.data), &req).unwrap();
     assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
-    let hidden = d
-        .families
-        .iter()
-        .find(|f| f.family == Family::HiddenValve)
-        .unwrap();
+    let hidden = hidden_valve_of(&d);
     assert_eq!(hidden.vote, Vote::Undetermined, "{}", hidden.note);
     let h = hidden.hidden_valve.as_ref().unwrap();
     assert!(h.ratio < 60.0, "{h:?}");
