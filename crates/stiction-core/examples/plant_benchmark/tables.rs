@@ -77,12 +77,13 @@ pub(super) fn levels_table(md: &mut String, groups: &Groups) {
 
 /// With `--thorough`: the hidden-valve family per class (where it ran, its ratio, its votes).
 pub(super) fn hidden_valve_table(md: &mut String, groups: &Groups) {
-    use stiction_core::diagnose::evidence::hidden_valve::THRESHOLD;
+    use stiction_core::diagnose::evidence::hidden_valve::{DRAWS, THRESHOLD};
     use stiction_core::diagnose::{Family, Vote};
     let _ = writeln!(
         md,
         "The hidden-valve family (with `--thorough`; it runs where the other families have not decided `stiction`, on an oscillating \
-         loop with PV recorded and OP within 10 % of span, and votes stiction from a ratio of {THRESHOLD:.0}):\n"
+         loop with PV recorded and OP within 10 % of span, and votes stiction from a ratio of {THRESHOLD:.0}, the median of {DRAWS} draws of \
+         the particle filter's noise where the first reaches it; the ratios below are the median where there were {DRAWS}):\n"
     );
     let _ = writeln!(
         md,
