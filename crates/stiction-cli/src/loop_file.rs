@@ -107,7 +107,7 @@ pub struct Columns {
     /// finds more sticky valves in records sampled at every controller execution, 1 to 3 s
     /// a loop of 2,000 samples); where no family has decided stiction on a limit cycle, also the
     /// hidden-valve family (a particle filter over a valve that slips between the samples,
-    /// about 3 s more on two cores)
+    /// about 1 s more on two cores, 3 s where it votes stiction: the median of three draws)
     #[arg(long)]
     pub thorough: bool,
     #[command(flatten)]

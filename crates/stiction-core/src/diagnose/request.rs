@@ -36,7 +36,8 @@ pub struct DiagnoseRequest {
     /// Stenman valve scored on PV's levels. Finds more sticky valves on records sampled at every
     /// controller execution, at 1 to 3 s a loop of 2,000 samples. Where the other families have
     /// not decided `stiction`, the hidden-valve family runs too
-    /// ([`super::evidence::hidden_valve`]; about 3 s more on two cores where it judges).
+    /// ([`super::evidence::hidden_valve`]; about 1 s more on two cores where it judges, about 3 s
+    /// where it votes stiction: a vote is the median of three draws of its particle filter).
     #[serde(default)]
     pub thorough: bool,
 }

@@ -80,7 +80,8 @@ def diagnose(
         on PV's levels): more sticky valves found on records sampled at every controller
         execution, at 1 to 3 s a loop of 2,000 samples; where no family has decided stiction on
         a limit cycle, also the hidden-valve family (a particle filter over a valve that slips
-        between the samples; about 3 s more on two cores).
+        between the samples; about 1 s more on two cores, 3 s where it votes stiction: the
+        median of three draws).
 
     Missing values (NaN, None, historian states such as "Bad Input") are gaps.
     """
