@@ -2,11 +2,23 @@
 #[path = "../examples/common/catalogue_loop.rs"]
 mod catalogue_loop;
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
 use std::hint::black_box;
 use stiction_core::diagnose::{diagnose, DiagnoseRequest, LoopRecord};
 use stiction_core::models::{Model, Stenman};
 use stiction_core::sim::{ClosedLoop, Pi, Process};
+
+/// `diagnose` of `rec` under each request, as a criterion function of the request's name.
+fn bench_each(
+    g: &mut BenchmarkGroup<WallTime>,
+    rec: &LoopRecord,
+    named: &[(String, DiagnoseRequest)],
+) {
+    for (name, req) in named {
+        g.bench_function(name, |b| b.iter(|| diagnose(black_box(rec), req).unwrap()));
+    }
+}
 
 fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("diagnose");
@@ -26,28 +38,28 @@ fn benches(c: &mut Criterion) {
                 time: Some(&data.t),
                 auto: None,
             };
-            let req = DiagnoseRequest::default();
-            g.bench_function(format!("{name}_{n}"), |b| {
-                b.iter(|| diagnose(black_box(&rec), &req).unwrap())
-            });
-            let indices_only = DiagnoseRequest {
-                quantify: false,
-                ..DiagnoseRequest::default()
-            };
-            g.bench_function(format!("{name}_{n}_without_quantify"), |b| {
-                b.iter(|| diagnose(black_box(&rec), &indices_only).unwrap())
-            });
+            let mut named = vec![
+                (format!("{name}_{n}"), DiagnoseRequest::default()),
+                (
+                    format!("{name}_{n}_without_quantify"),
+                    DiagnoseRequest {
+                        quantify: false,
+                        ..DiagnoseRequest::default()
+                    },
+                ),
+            ];
             if n == 2000 {
                 // --thorough: the model family's levels test besides (a fit per Stenman valve)
-                let thorough = DiagnoseRequest {
-                    quantify: false,
-                    thorough: true,
-                    ..DiagnoseRequest::default()
-                };
-                g.bench_function(format!("{name}_{n}_thorough_without_quantify"), |b| {
-                    b.iter(|| diagnose(black_box(&rec), &thorough).unwrap())
-                });
+                named.push((
+                    format!("{name}_{n}_thorough_without_quantify"),
+                    DiagnoseRequest {
+                        quantify: false,
+                        thorough: true,
+                        ..DiagnoseRequest::default()
+                    },
+                ));
             }
+            bench_each(&mut g, &rec, &named);
         }
     }
     // the loop family's case (issue 14): a fast loop, Ts = 2 s, a 2 % band, a two-minute cycle
@@ -74,41 +86,43 @@ fn benches(c: &mut Criterion) {
         time: Some(&data.t),
         auto: None,
     };
-    for quantify in [true, false] {
-        let req = DiagnoseRequest {
-            ts: 2.0,
-            quantify,
-            ..DiagnoseRequest::default()
-        };
-        let name = if quantify {
-            "fast_sticky_2000"
-        } else {
-            "fast_sticky_2000_without_quantify"
-        };
-        g.bench_function(name, |b| {
-            b.iter(|| diagnose(black_box(&rec), &req).unwrap())
-        });
-    }
+    let fast = |quantify| DiagnoseRequest {
+        ts: 2.0,
+        quantify,
+        ..DiagnoseRequest::default()
+    };
+    bench_each(
+        &mut g,
+        &rec,
+        &[
+            ("fast_sticky_2000".into(), fast(true)),
+            ("fast_sticky_2000_without_quantify".into(), fast(false)),
+        ],
+    );
     // --thorough where the hidden-valve family runs: a fast loop of the catalogue's calibration
     // set whose valve slips between the samples (fast-c-0007; the families without it call it
     // no_stiction), beside the same loop judged by default
     let l = stiction_core::sim::catalogue::find("fast-c-0007").unwrap();
     let rec = catalogue_loop::record(&l);
-    for thorough in [false, true] {
-        let req = DiagnoseRequest {
-            quantify: false,
-            thorough,
-            ..catalogue_loop::request(&l)
-        };
-        let name = if thorough {
-            "hidden_valve_2000_thorough_without_quantify"
-        } else {
-            "hidden_valve_2000_without_quantify"
-        };
-        g.bench_function(name, |b| {
-            b.iter(|| diagnose(black_box(&rec), &req).unwrap())
-        });
-    }
+    let catalogue = |thorough| DiagnoseRequest {
+        quantify: false,
+        thorough,
+        ..catalogue_loop::request(&l)
+    };
+    bench_each(
+        &mut g,
+        &rec,
+        &[
+            (
+                "hidden_valve_2000_without_quantify".into(),
+                catalogue(false),
+            ),
+            (
+                "hidden_valve_2000_thorough_without_quantify".into(),
+                catalogue(true),
+            ),
+        ],
+    );
     g.finish();
 }
 
