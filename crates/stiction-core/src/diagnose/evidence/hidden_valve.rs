@@ -15,6 +15,7 @@ use super::{Context, EvidenceFamily, Family, FamilyEvidence};
 use crate::diagnose::oscillation::amplitude;
 use crate::diagnose::result::Vote;
 use crate::hidden_valve::{test, HiddenValveTest, Particles, Record, TestSettings};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The hidden-valve family.
@@ -150,7 +151,7 @@ impl EvidenceFamily for HiddenValve {
         };
         let pct = 100.0 * t.band / (hi - lo);
         let sticky = t.ratio >= THRESHOLD;
-        let note = note(&t, &draws, hi - lo);
+        let note = note(&t, &draws, pct, hi - lo);
         let evidence = HiddenValveEvidence {
             ratio: t.ratio,
             band: t.band,
@@ -199,7 +200,6 @@ fn drawn(
     let first = run(1)?;
     let mut tests = vec![first];
     if tests[0].ratio >= THRESHOLD {
-        use rayon::prelude::*;
         let more: Vec<HiddenValveTest> = (2..=DRAWS).into_par_iter().filter_map(run).collect();
         tests.extend(more);
     }
@@ -212,8 +212,8 @@ fn drawn(
     Some((median, draws, evaluations))
 }
 
-/// The family's note on the (median) test `t` and the draws' ratios.
-fn note(t: &HiddenValveTest, draws: &[f64], op_span: f64) -> String {
+/// The family's note on the (median) test `t`, its band `pct` in % of span, and the draws' ratios.
+fn note(t: &HiddenValveTest, draws: &[f64], pct: f64, op_span: f64) -> String {
     let of_draws = if draws.len() > 1 {
         let each: Vec<String> = draws.iter().map(|r| format!("{r:.0}")).collect();
         format!(
@@ -233,7 +233,7 @@ fn note(t: &HiddenValveTest, draws: &[f64], op_span: f64) -> String {
         format!(
             "PV is far likelier through a hidden valve with a band of {:.1} % of span{lands} that slips between the samples than through one \
              that follows OP (ratio {:.0} against {THRESHOLD:.0}{of_draws})",
-            100.0 * t.band / op_span,
+            pct,
             t.ratio
         )
     } else {
