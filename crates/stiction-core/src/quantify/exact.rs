@@ -35,7 +35,7 @@ pub(super) fn exact_stenman(
     // achievable costs to start from: simulations that exceed them stop early (such a cell can
     // never be optimal, so the optimal set is the same whatever the order of the work)
     let start_bounds: Vec<f64> = if full {
-        problems.iter().map(|p| p.min_cost_1d(&scan)).collect()
+        super::problem::min_costs_1d(problems, &scan)
     } else {
         let scan_costs: Vec<Vec<f64>> = problems.iter().map(|p| p.costs_1d(&scan)).collect();
         chunks = around_best(&chunks, &scan_costs);

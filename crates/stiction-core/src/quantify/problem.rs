@@ -67,6 +67,12 @@ impl<'a> Hammerstein<'a> {
 
     /// The valve trajectory of `theta` as the linear part sees it, into `mv` (`self.len()` long).
     pub(super) fn valve_into(&self, theta: &[f64], mv: &mut [f64]) {
+        self.valve_into_with(theta, mv, &mut Vec::new());
+    }
+
+    /// As [`Hammerstein::valve_into`], with a caller's buffer for the whole trajectory when the
+    /// problem compares changes over a lag.
+    fn valve_into_with(&self, theta: &[f64], mv: &mut [f64], full: &mut Vec<f64>) {
         let model = self.kind.build(theta).expect("candidates are repaired");
         if self.lag == 0 {
             model.simulate_from_into(self.op, self.start, mv);
@@ -74,9 +80,20 @@ impl<'a> Hammerstein<'a> {
                 *v -= self.offset;
             }
         } else {
-            let full = model.simulate_from(self.op, self.start);
-            difference(&full, self.lag, mv);
+            full.resize(self.op.len(), 0.0);
+            model.simulate_from_into(self.op, self.start, full);
+            difference(full, self.lag, mv);
         }
+    }
+
+    /// Whether `other` simulates the same valve trajectories (it differs at most in the linear
+    /// structure).
+    fn same_valve(&self, other: &Self) -> bool {
+        self.kind == other.kind
+            && std::ptr::eq(self.op, other.op)
+            && self.start.map(f64::to_bits) == other.start.map(f64::to_bits)
+            && self.lag == other.lag
+            && self.offset.to_bits() == other.offset.to_bits()
     }
 
     pub(super) fn valve(&self, theta: &[f64]) -> Vec<f64> {
@@ -137,6 +154,42 @@ impl<'a> Hammerstein<'a> {
             )
             .reduce(|| f64::INFINITY, f64::min)
     }
+}
+
+/// [`Hammerstein::min_cost_1d`] of each of several problems that differ only in the linear
+/// structure: each candidate's valve is simulated once for all of them (the same groups, and in
+/// each group the same bound per problem, so the same least costs).
+pub(super) fn min_costs_1d(problems: &[Hammerstein], values: &[f64]) -> Vec<f64> {
+    let Some(first) = problems.first() else {
+        return Vec::new();
+    };
+    if !problems.iter().all(|p| first.same_valve(p)) {
+        return problems.iter().map(|p| p.min_cost_1d(values)).collect();
+    }
+    let n = first.len();
+    let worst = || vec![f64::INFINITY; problems.len()];
+    values
+        .par_chunks(8)
+        .map_init(
+            || (vec![0.0; n], Vec::new()),
+            |(mv, full), group| {
+                let mut best = worst();
+                for &v in group {
+                    first.valve_into_with(&[v], mv, full);
+                    for (p, b) in problems.iter().zip(best.iter_mut()) {
+                        let cost = p
+                            .prepared
+                            .fit_bounded(mv, *b)
+                            .map_or(f64::INFINITY, |f| f.sse_simulation);
+                        *b = b.min(cost);
+                    }
+                }
+                best
+            },
+        )
+        .reduce(worst, |a, b| {
+            a.iter().zip(&b).map(|(x, y)| x.min(*y)).collect()
+        })
 }
 
 impl CostFunction for Hammerstein<'_> {

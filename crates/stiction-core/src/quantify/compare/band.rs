@@ -3,7 +3,7 @@
 use crate::identify::{Data, Structure};
 use crate::models::ModelKind;
 use crate::quantify::exact::{exact_stenman, merged_top_cells};
-use crate::quantify::problem::Hammerstein;
+use crate::quantify::problem::{min_costs_1d, Hammerstein};
 
 /// A staged walk starts on this many samples, or this many oscillation periods of the PV if
 /// more, up to half the record, when the record has at least `STAGE_FROM` samples.
@@ -24,16 +24,38 @@ const START_GAIN: f64 = 0.7;
 /// Points of the band scan that judges each start.
 const START_GRID: usize = 32;
 
-/// The first samples a staged walk (and the choice of the valve start) judges.
-fn first_samples(y: &[f64], lag: usize) -> usize {
-    let n = y.len() + lag;
-    if n >= STAGE_FROM {
+/// The record the band is walked on: OP, the PV's changes over the lag (`y`, from sample `t0`
+/// on) and the period of their cycle (0 without one), measured once for every stage.
+pub(super) struct Record<'a> {
+    pub op: &'a [f64],
+    pub y: &'a [f64],
+    pub t0: usize,
+    pub lag: usize,
+    pub period: f64,
+}
+
+impl<'a> Record<'a> {
+    pub fn new(op: &'a [f64], y: &'a [f64], t0: usize, lag: usize) -> Self {
         let period = crate::detect::regularity(y, 1.0).period.unwrap_or(0.0);
-        STAGE_SAMPLES
-            .max((STAGE_PERIODS * period) as usize)
-            .min(n / 2)
-    } else {
-        n / 2
+        Self {
+            op,
+            y,
+            t0,
+            lag,
+            period,
+        }
+    }
+
+    /// The first samples a staged walk (and the choice of the valve start) judges.
+    fn first_samples(&self) -> usize {
+        let n = self.y.len() + self.lag;
+        if n >= STAGE_FROM {
+            STAGE_SAMPLES
+                .max((STAGE_PERIODS * self.period) as usize)
+                .min(n / 2)
+        } else {
+            n / 2
+        }
     }
 }
 
@@ -53,17 +75,11 @@ fn problems<'a>(
 /// Where the valve stood at the first sample: of candidates around the first OP, the one whose
 /// scan of the band on the first samples fits best (under any of the structures). Returns it and the
 /// cells walked.
-pub(super) fn valve_start(
-    op: &[f64],
-    y: &[f64],
-    t0: usize,
-    lag: usize,
-    structures: &[Structure],
-    op_range: f64,
-) -> (f64, u64) {
-    let period = crate::detect::regularity(y, 1.0).period.unwrap_or(0.0);
-    let m = first_samples(y, lag)
-        .min(START_SAMPLES.max((START_PERIODS * period) as usize) + lag)
+pub(super) fn valve_start(r: &Record, structures: &[Structure], op_range: f64) -> (f64, u64) {
+    let Record { op, y, t0, lag, .. } = *r;
+    let m = r
+        .first_samples()
+        .min(START_SAMPLES.max((START_PERIODS * r.period) as usize) + lag)
         .max(lag + 4 * t0);
     let (op_m, y_m) = (&op[..m], &y[..m - lag]);
     let data = Data::new(y_m, t0);
@@ -86,9 +102,8 @@ pub(super) fn valve_start(
     for f in START_SHARES {
         let x0 = op[0] + f * span;
         let ps = problems(op_m, &data, structures, lag, x0);
-        let cost = ps
-            .iter()
-            .map(|p| p.min_cost_1d(&grid))
+        let cost = min_costs_1d(&ps, &grid)
+            .into_iter()
             .fold(f64::INFINITY, f64::min);
         walked += (grid.len() * ps.len()) as u64;
         if f == 0.0 {
@@ -112,19 +127,18 @@ pub(super) fn valve_start(
 /// structure's best band (least-squares fits ranked by simulation error; the caller compares
 /// structures after moving each fit to its output-error optimum), and the cells walked.
 pub(super) fn exact_band(
-    op: &[f64],
-    y: &[f64],
+    r: &Record,
     data: &Data,
     structures: &[Structure],
     op_range: f64,
-    lag: usize,
     x0: f64,
 ) -> (Vec<(f64, Structure)>, u64) {
+    let Record { op, y, lag, .. } = *r;
     let n = op.len();
     let whole = problems(op, data, structures, lag, x0);
     let mut walked = 0;
     let outcomes = if n >= STAGE_FROM {
-        let m = first_samples(y, lag);
+        let m = r.first_samples();
         let first = Data::new(&y[..m - lag], data.t0);
         let staged = problems(&op[..m], &first, structures, lag, x0);
         let stage = exact_stenman(&staged, (0.0, op_range), true, None);

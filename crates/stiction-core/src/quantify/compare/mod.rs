@@ -29,7 +29,7 @@ pub use dependence::correlation_span;
 use super::problem::{difference, range};
 use crate::identify::{self, Data, Fit, SearchRange, Structure};
 use crate::models::{Kano, Model, Stenman};
-use band::{exact_band, valve_start};
+use band::{exact_band, valve_start, Record};
 use fits::Fits;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -178,14 +178,15 @@ pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitC
             evaluations += 1;
         }
     }
-    let (x0, walked) = valve_start(op, &setup.y, setup.t0, setup.lag, &structures, op_range);
+    let record = Record::new(op, &setup.y, setup.t0, setup.lag);
+    let (x0, walked) = valve_start(&record, &structures, op_range);
     evaluations += walked;
     let problem = Problem {
         start: Some(x0),
         ..problem
     };
     // the Stenman band, exactly: every distinct valve trajectory, under each structure
-    let (bands, walked) = exact_band(op, &setup.y, &data, &structures, op_range, setup.lag, x0);
+    let (bands, walked) = exact_band(&record, &data, &structures, op_range, x0);
     evaluations += walked;
     // the linear loop and each structure's stiction fit, over the structures and their
     // neighbours, each moved to its output-error optimum: the comparison is fair only at both
