@@ -15,6 +15,11 @@ use std::collections::BTreeMap;
 const TOP_CELLS: usize = 24;
 /// Chunks the whole d-range is cut into (geometric: bands are usually small).
 const CHUNKS: usize = 64;
+/// A staged search's ranges are cut into at least this many chunks in all (each range into one
+/// to four): enough for the threads, and no more, since each chunk simulates its first valve and
+/// sums its first cell over the whole record afresh (with 15-20 ranges, as limit cycles give,
+/// four chunks a range made that overhead most of the stage).
+const STAGED_CHUNKS: usize = 8;
 /// Consecutive cells' sums are updated incrementally; a full recomputation this often bounds
 /// rounding.
 const FULL_EVERY: usize = 256;
@@ -63,14 +68,14 @@ pub(super) fn exact_stenman(
         .collect()
 }
 
-/// The chunks to walk: a staged search's ranges, each cut in a few chunks for the threads, or the
-/// whole range cut geometrically.
+/// The chunks to walk: a staged search's ranges, each cut in a few chunks for the threads
+/// ([`STAGED_CHUNKS`]), or the whole range cut geometrically.
 fn chunks(lo: f64, hi: f64, only: Option<&[(f64, f64)]>) -> Vec<(f64, f64)> {
     match only {
         Some(ranges) => ranges
             .iter()
             .flat_map(|&(a, b)| {
-                let k = 4;
+                let k = (STAGED_CHUNKS / ranges.len()).clamp(1, 4);
                 (0..k).map(move |i| {
                     (
                         a + (b - a) * i as f64 / k as f64,
