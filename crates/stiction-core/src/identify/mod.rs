@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 pub mod levels;
 mod output_error;
+mod pair;
 mod physical;
 mod prepared;
 mod select;
@@ -25,7 +26,7 @@ mod simulate;
 use output_error::*;
 pub use output_error::{polish_output_error, refine_output_error};
 pub use physical::{physical, Physical};
-pub use prepared::{Prepared, ValveSums};
+pub use prepared::{costs_from_sums, Prepared, ValveSums};
 pub use select::{bic, level_simulation_bic, select, simulation_bic, Selection};
 pub use simulate::simulate_pv;
 use simulate::*;

@@ -3,6 +3,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use super::pair::{simulate_one, simulate_pair, Run};
 use super::*;
 
 /// The sums of a least-squares fit that involve the valve position.
@@ -209,14 +210,11 @@ impl<'a> Prepared<'a> {
         ValveSums { mm, ym, m1, hm }
     }
 
-    fn finish_n<const NA: usize, const NB: usize>(
+    /// The least-squares coefficients from the sums, and the right-hand side they solve.
+    fn solve_n<const NA: usize, const NB: usize>(
         &self,
         sums: &ValveSums,
-        mv: &[f64],
-        bound: f64,
-    ) -> Option<Fit> {
-        let (s, y, t0) = (self.s, self.y, self.t0);
-        let nk = s.nk;
+    ) -> Option<([f64; MAX_P], [f64; MAX_P])> {
         let ValveSums { mm, ym, m1, hm } = *sums;
         // assemble [y-lags, mv-lags, 1] (upper triangle)
         let p = NA + NB + 1;
@@ -241,7 +239,45 @@ impl<'a> Prepared<'a> {
         }
         g[p - 1][p - 1] = self.count;
         h[p - 1] = self.y_sum;
-        let theta = solve(&g, &h, p)?;
+        Some((solve(&g, &h, p)?, h))
+    }
+
+    /// The simulation of the least-squares fit from `sums` on `mv`, to be run beside another
+    /// ([`costs_from_sums`]); `None` when the normal equations are singular.
+    fn run<'m>(&'m self, sums: &ValveSums, mv: &'m [f64], bound: f64) -> Option<Run<'m>> {
+        let (na, nb) = (self.s.na, self.s.nb);
+        let (theta, _) = match (na, nb) {
+            (0, 1) => self.solve_n::<0, 1>(sums),
+            (0, 2) => self.solve_n::<0, 2>(sums),
+            (1, 1) => self.solve_n::<1, 1>(sums),
+            (1, 2) => self.solve_n::<1, 2>(sums),
+            (2, 1) => self.solve_n::<2, 1>(sums),
+            (2, 2) => self.solve_n::<2, 2>(sums),
+            _ => unreachable!("orders are checked when prepared"),
+        }?;
+        Some(Run {
+            y: self.y,
+            mv,
+            nk: self.s.nk,
+            na,
+            nb,
+            a: std::array::from_fn(|i| if i < na { theta[i] } else { 0.0 }),
+            b: std::array::from_fn(|j| if j < nb { theta[na + j] } else { 0.0 }),
+            c: theta[na + nb],
+            bound,
+        })
+    }
+
+    fn finish_n<const NA: usize, const NB: usize>(
+        &self,
+        sums: &ValveSums,
+        mv: &[f64],
+        bound: f64,
+    ) -> Option<Fit> {
+        let (s, y, t0) = (self.s, self.y, self.t0);
+        let nk = s.nk;
+        let p = NA + NB + 1;
+        let (theta, h) = self.solve_n::<NA, NB>(sums)?;
         let sse_one_step = (self.yy - (0..p).map(|i| theta[i] * h[i]).sum::<f64>()).max(0.0);
         let a: [f64; NA] = std::array::from_fn(|i| theta[i]);
         let b: [f64; NB] = std::array::from_fn(|j| theta[NA + j]);
@@ -257,4 +293,41 @@ impl<'a> Prepared<'a> {
             sst: self.yy.max(f64::MIN_POSITIVE),
         })
     }
+}
+
+/// The simulation errors of the least-squares fits of several structures (`prepared`, all on the
+/// same data) on one valve trajectory `mv`, from each one's `sums`, each stopped over its bound:
+/// for each, what `fit_from_sums(sums, mv, bound)` gives as `sse_simulation` (infinite without a
+/// fit), bit for bit. The simulations run two at a time, side by side.
+pub fn costs_from_sums(
+    prepared: &[&Prepared],
+    sums: &[ValveSums],
+    mv: &[f64],
+    bounds: &[f64],
+) -> Vec<f64> {
+    let runs: Vec<Option<Run>> = prepared
+        .iter()
+        .zip(sums)
+        .zip(bounds)
+        .map(|((p, s), &b)| p.run(s, mv, b))
+        .collect();
+    let mut costs = vec![f64::INFINITY; prepared.len()];
+    // the fits that exist, in pairs of equally long outputs (a level and a change per sample
+    // are equally long: both the record's length)
+    let live: Vec<usize> = (0..runs.len()).filter(|&i| runs[i].is_some()).collect();
+    let t0 = prepared.first().map_or(0, |p| p.t0);
+    for pair in live.chunks(2) {
+        match *pair {
+            [i, j] => {
+                let (a, b) = (runs[i].as_ref().unwrap(), runs[j].as_ref().unwrap());
+                [costs[i], costs[j]] = simulate_pair([a, b], t0);
+            }
+            [i] => {
+                let r = runs[i].as_ref().unwrap();
+                costs[i] = simulate_one(r, t0);
+            }
+            _ => unreachable!("chunks of two"),
+        }
+    }
+    costs
 }

@@ -165,6 +165,7 @@ impl Walk {
         let mut bounds = start_bounds.to_vec();
         let mut sums: Vec<identify::ValveSums> = Vec::new();
         let x0 = problems[0].start.unwrap_or(problems[0].op[0]);
+        let prepared: Vec<&identify::Prepared> = problems.iter().map(|p| &p.prepared).collect();
         exact::stenman_walk_changes(problems[0].op, x0, chunk, range, |cell, full, moved| {
             changed.clear();
             match moved {
@@ -179,19 +180,10 @@ impl Walk {
             } else {
                 sums = problems.iter().map(|p| p.prepared.sums(seen)).collect();
             }
-            let costs: Vec<f64> = problems
-                .iter()
-                .zip(&sums)
-                .zip(bounds.iter_mut())
-                .map(|((p, s), bound)| {
-                    let c = p
-                        .prepared
-                        .fit_from_sums(s, seen, *bound)
-                        .map_or(f64::INFINITY, |f| f.sse_simulation);
-                    *bound = bound.min(c);
-                    c
-                })
-                .collect();
+            let costs = identify::costs_from_sums(&prepared, &sums, seen, &bounds);
+            for (bound, &c) in bounds.iter_mut().zip(&costs) {
+                *bound = bound.min(c);
+            }
             if moved.is_none() {
                 prev.copy_from_slice(seen);
             } else {
