@@ -3,6 +3,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use super::pair::{simulate_pair_errors, Run};
 use super::*;
 
 pub(super) const MAX_P: usize = 8;
@@ -183,17 +184,44 @@ pub(super) fn levenberg_marquardt(
     let mut lambda = 1e-3;
     let mut jac = vec![0.0; m * p];
     let mut rk = Vec::new();
+    let mut rk2 = Vec::new();
+    // a parameter vector's simulation, to be run beside another's
+    let run = |theta: &[f64]| Run {
+        y,
+        mv,
+        nk: s.nk,
+        na: s.na,
+        nb: s.nb,
+        a: std::array::from_fn(|i| if i < s.na { theta[i] } else { 0.0 }),
+        b: std::array::from_fn(|j| if j < s.nb { theta[s.na + j] } else { 0.0 }),
+        c: theta[p - 1],
+        bound: f64::INFINITY,
+    };
+    let step = |theta: &[f64], k: usize| 1e-6 * theta[k].abs().max(1e-3);
+    let nudged = |theta: &[f64], k: usize| {
+        let mut t = theta.to_vec();
+        t[k] += step(theta, k);
+        t
+    };
     for _ in 0..iterations {
-        for k in 0..p {
-            let h = 1e-6 * theta[k].abs().max(1e-3);
-            let mut t = theta.clone();
-            t[k] += h;
-            if !residuals(&t, &mut rk).is_finite() {
-                return best_of(start, y, mv, t0, &theta, sse);
-            }
-            // column by column (each column contiguous, so the divisions vectorise)
-            for (j, (a, b)) in jac[k * m..(k + 1) * m].iter_mut().zip(r.iter().zip(&rk)) {
-                *j = (a - b) / h;
+        // the Jacobian's columns two at a time, each simulation beside the next one's
+        for k in (0..p).step_by(2) {
+            let sses = if k + 1 < p {
+                let (t, u) = (nudged(&theta, k), nudged(&theta, k + 1));
+                simulate_pair_errors([&run(&t), &run(&u)], t0, [&mut rk, &mut rk2]).to_vec()
+            } else {
+                vec![residuals(&nudged(&theta, k), &mut rk)]
+            };
+            for (i, sse_k) in sses.into_iter().enumerate() {
+                if !sse_k.is_finite() {
+                    return best_of(start, y, mv, t0, &theta, sse);
+                }
+                let (col, rc) = (k + i, if i == 0 { &rk } else { &rk2 });
+                let h = step(&theta, col);
+                // column by column (each column contiguous, so the divisions vectorise)
+                for (j, (a, b)) in jac[col * m..(col + 1) * m].iter_mut().zip(r.iter().zip(rc)) {
+                    *j = (a - b) / h;
+                }
             }
         }
         let (g, h) = normal_equations(p, 0..m, |i, row| {

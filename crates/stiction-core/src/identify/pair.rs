@@ -73,6 +73,25 @@ impl<'a> Lane<'a> {
 /// the same order; a run over its bound at a check every 64 samples is infinite). Both runs'
 /// outputs must be equally long.
 pub(super) fn simulate_pair(runs: [&Run; 2], t0: usize) -> [f64; 2] {
+    pair::<false>(runs, t0, [&mut [], &mut []])
+}
+
+/// As [`simulate_pair`], also writing each run's errors (output less simulation, from `t0` on)
+/// into `errors`, as `simulate_n`'s simulated output gives them.
+pub(super) fn simulate_pair_errors(
+    runs: [&Run; 2],
+    t0: usize,
+    errors: [&mut Vec<f64>; 2],
+) -> [f64; 2] {
+    let len = runs[0].y.len() - t0;
+    let [ea, eb] = errors;
+    ea.resize(len, 0.0);
+    eb.resize(len, 0.0);
+    pair::<true>(runs, t0, [ea, eb])
+}
+
+fn pair<const ERRORS: bool>(runs: [&Run; 2], t0: usize, errors: [&mut [f64]; 2]) -> [f64; 2] {
+    let [ea, eb] = errors;
     let len = runs[0].y.len() - t0;
     debug_assert_eq!(runs[1].y.len() - t0, len);
     let (la, lb) = (Lane::new(runs[0], t0, len), Lane::new(runs[1], t0, len));
@@ -102,6 +121,9 @@ pub(super) fn simulate_pair(runs: [&Run; 2], t0: usize) -> [f64; 2] {
         let (be0, be1) = (bt[k] - bv0, bt[k + 1] - bv1);
         asse += ae0 * ae0 + ae1 * ae1;
         bsse += be0 * be0 + be1 * be1;
+        if ERRORS {
+            (ea[k], ea[k + 1], eb[k], eb[k + 1]) = (ae0, ae1, be0, be1);
+        }
         (ay2, ay1) = (av0, av1);
         (by2, by1) = (bv0, bv1);
         k += 2;
@@ -119,6 +141,9 @@ pub(super) fn simulate_pair(runs: [&Run; 2], t0: usize) -> [f64; 2] {
         let (ae, be) = (at[k] - av, bt[k] - bv);
         asse += ae * ae;
         bsse += be * be;
+        if ERRORS {
+            (ea[k], eb[k]) = (ae, be);
+        }
     }
     let result = |sse: f64, over: bool| {
         if over || !sse.is_finite() {
@@ -161,6 +186,8 @@ pub(super) fn simulate_one(r: &Run, t0: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::identify::simulate::simulate_sse;
+    use crate::identify::Structure;
     use proptest::prelude::*;
 
     fn run<'a>(
@@ -214,6 +241,20 @@ mod tests {
             let pair = simulate_pair([&runs[0], &runs[1]], t0);
             for i in 0..2 {
                 prop_assert_eq!(pair[i].to_bits(), alone(i, bounds[i]).to_bits(), "run {}", i);
+            }
+            // unbounded, with the errors written: what a simulation alone gives and simulates
+            let free = [run(&y, &mv, orders[0], coef[0], f64::INFINITY), run(&y, &mv, orders[1], coef[1], f64::INFINITY)];
+            let (mut ea, mut eb) = (Vec::new(), Vec::new());
+            let sses = simulate_pair_errors([&free[0], &free[1]], t0, [&mut ea, &mut eb]);
+            for (i, errors) in [ea, eb].iter().enumerate() {
+                let (na, nb, nk) = orders[i];
+                let s = Structure { integrating: false, na, nb, nk };
+                let mut sim = Vec::new();
+                let sse = simulate_sse(&y, &mv, s, &coef[i][..na], &coef[i][2..2 + nb], coef[i][4], t0, Some(&mut sim));
+                prop_assert_eq!(sses[i].to_bits(), sse.to_bits(), "run {}", i);
+                let alone: Vec<u64> = y[t0..].iter().zip(&sim[t0..]).map(|(a, b)| (a - b).to_bits()).collect();
+                let paired: Vec<u64> = errors.iter().map(|e| e.to_bits()).collect();
+                prop_assert_eq!(paired, alone, "run {}", i);
             }
         }
     }
