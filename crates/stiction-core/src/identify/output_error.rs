@@ -3,7 +3,8 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use super::pair::{simulate_pair_errors, Run};
+use super::pair::simulate_pair_errors;
+use super::simulate::Run;
 use super::*;
 
 pub(super) const MAX_P: usize = 8;
@@ -144,6 +145,66 @@ pub fn polish_output_error(data: &Data, mv: &[f64], start: &Fit) -> Option<Fit> 
 /// Levenberg-Marquardt iterations on the simulation error after Steiglitz-McBride.
 pub(super) const LM_ITERATIONS: usize = 12;
 
+/// The forward-difference Jacobian of a fit's simulation errors on `mv` (structure `s`): each
+/// parameter nudged in turn, the nudged simulations two at a time, side by side.
+struct Nudges<'a> {
+    y: &'a [f64],
+    mv: &'a [f64],
+    t0: usize,
+    s: Structure,
+    /// The errors of the two nudged simulations run last.
+    errors: [Vec<f64>; 2],
+}
+
+impl<'a> Nudges<'a> {
+    /// The nudge of parameter `k` of `theta`.
+    fn step(theta: &[f64], k: usize) -> f64 {
+        1e-6 * theta[k].abs().max(1e-3)
+    }
+
+    /// `theta` with parameter `k` nudged, as a simulation to run.
+    fn run(&self, theta: &[f64], k: usize) -> Run<'a> {
+        let (na, nb) = (self.s.na, self.s.nb);
+        let mut t = theta.to_vec();
+        t[k] += Self::step(theta, k);
+        Run {
+            y: self.y,
+            mv: self.mv,
+            nk: self.s.nk,
+            na,
+            nb,
+            a: std::array::from_fn(|i| if i < na { t[i] } else { 0.0 }),
+            b: std::array::from_fn(|j| if j < nb { t[na + j] } else { 0.0 }),
+            c: t[na + nb],
+            bound: f64::INFINITY,
+        }
+    }
+
+    /// The Jacobian at `theta`, whose errors are `r`, into `jac` column by column; `false` when a
+    /// nudged simulation runs away.
+    fn jacobian(&mut self, theta: &[f64], r: &[f64], jac: &mut [f64]) -> bool {
+        let (p, m) = (theta.len(), r.len());
+        for k in (0..p).step_by(2) {
+            // an odd last column is simulated beside itself (the same errors twice)
+            let pair = [self.run(theta, k), self.run(theta, (k + 1).min(p - 1))];
+            let [ea, eb] = &mut self.errors;
+            let sses = simulate_pair_errors([&pair[0], &pair[1]], self.t0, [ea, eb]);
+            for (i, col) in [k, k + 1].into_iter().enumerate().filter(|&(_, c)| c < p) {
+                if !sses[i].is_finite() {
+                    return false;
+                }
+                let h = Self::step(theta, col);
+                // column by column (each column contiguous, so the divisions vectorise)
+                let e = &self.errors[i];
+                for (j, (a, b)) in jac[col * m..(col + 1) * m].iter_mut().zip(r.iter().zip(e)) {
+                    *j = (a - b) / h;
+                }
+            }
+        }
+        true
+    }
+}
+
 /// Polish a fit on its simulation (output-error) criterion by Levenberg-Marquardt with a
 /// forward-difference Jacobian (Marquardt 1963): Steiglitz-McBride can stop far from the optimum
 /// when the valve position is noisy (closed-loop data), and a comparison of fits is only fair at
@@ -189,45 +250,16 @@ pub(super) fn levenberg_marquardt(
     let mut lambda = 1e-3;
     let mut jac = vec![0.0; m * p];
     let mut rk = Vec::new();
-    let mut rk2 = Vec::new();
-    // a parameter vector's simulation, to be run beside another's
-    let run = |theta: &[f64]| Run {
+    let mut nudges = Nudges {
         y,
         mv,
-        nk: s.nk,
-        na: s.na,
-        nb: s.nb,
-        a: std::array::from_fn(|i| if i < s.na { theta[i] } else { 0.0 }),
-        b: std::array::from_fn(|j| if j < s.nb { theta[s.na + j] } else { 0.0 }),
-        c: theta[p - 1],
-        bound: f64::INFINITY,
-    };
-    let step = |theta: &[f64], k: usize| 1e-6 * theta[k].abs().max(1e-3);
-    let nudged = |theta: &[f64], k: usize| {
-        let mut t = theta.to_vec();
-        t[k] += step(theta, k);
-        t
+        t0,
+        s,
+        errors: [Vec::new(), Vec::new()],
     };
     for _ in 0..iterations {
-        // the Jacobian's columns two at a time, each simulation beside the next one's
-        for k in (0..p).step_by(2) {
-            let sses = if k + 1 < p {
-                let (t, u) = (nudged(&theta, k), nudged(&theta, k + 1));
-                simulate_pair_errors([&run(&t), &run(&u)], t0, [&mut rk, &mut rk2]).to_vec()
-            } else {
-                vec![residuals(&nudged(&theta, k), &mut rk)]
-            };
-            for (i, sse_k) in sses.into_iter().enumerate() {
-                if !sse_k.is_finite() {
-                    return best_of(start, y, mv, t0, &theta, sse);
-                }
-                let (col, rc) = (k + i, if i == 0 { &rk } else { &rk2 });
-                let h = step(&theta, col);
-                // column by column (each column contiguous, so the divisions vectorise)
-                for (j, (a, b)) in jac[col * m..(col + 1) * m].iter_mut().zip(r.iter().zip(rc)) {
-                    *j = (a - b) / h;
-                }
-            }
+        if !nudges.jacobian(&theta, &r, &mut jac) {
+            return best_of(start, y, mv, t0, &theta, sse);
         }
         let (g, h) = normal_equations(p, 0..m, |i, row| {
             for (k, v) in row[..p].iter_mut().enumerate() {

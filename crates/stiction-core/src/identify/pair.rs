@@ -1,25 +1,10 @@
 //! Two output-error simulations side by side: the exact walk fits every valve trajectory under
 //! each of a few structures, and each simulation is a recursion whose every step waits for the one
 //! before, so one alone leaves the processor idle most of the time. Run in pairs, bit for bit what
-//! [`simulate_n`] gives each (three side by side, or one kernel generic in their number, measured
+//! `simulate_n` gives each (three side by side, or one kernel generic in their number, measured
 //! 2-3 % slower on the batch: the registers spill).
 
-use super::simulate::simulate_n;
-
-/// One output-error simulation of a pair run side by side ([`simulate_pair`]): a fit's
-/// coefficients (orders at most 2), its output and input, and its bound.
-#[derive(Clone, Copy)]
-pub(super) struct Run<'a> {
-    pub y: &'a [f64],
-    pub mv: &'a [f64],
-    pub nk: usize,
-    pub na: usize,
-    pub nb: usize,
-    pub a: [f64; 2],
-    pub b: [f64; 2],
-    pub c: f64,
-    pub bound: f64,
-}
+use super::simulate::Run;
 
 /// A run's state: the recursion's constants, its lagged inputs, its target and its last outputs.
 struct Lane<'a> {
@@ -39,7 +24,7 @@ struct Lane<'a> {
 }
 
 impl<'a> Lane<'a> {
-    /// The same constants and starting outputs as [`simulate_n`] with the run's orders (a
+    /// The same constants and starting outputs as `simulate_n` with the run's orders (a
     /// missing order's coefficient is 0, which adds a zero product: the same sums).
     fn new(r: &Run<'a>, t0: usize, len: usize) -> Self {
         let a0 = if r.na > 0 { r.a[0] } else { 0.0 };
@@ -70,7 +55,7 @@ impl<'a> Lane<'a> {
 
 /// Two output-error simulations from sample `t0` on, interleaved: each is a recursion whose
 /// every step waits for the one before, so one alone leaves the processor idle most of the time.
-/// Each returns what [`simulate_n`] returns for it, bit for bit (the same products and sums in
+/// Each returns what `simulate_n` returns for it, bit for bit (the same products and sums in
 /// the same order; a run over its bound at a check every 64 samples is infinite). Both runs'
 /// outputs must be equally long.
 pub(super) fn simulate_pair(runs: [&Run; 2], t0: usize) -> [f64; 2] {
@@ -156,38 +141,10 @@ fn pair<const ERRORS: bool>(runs: [&Run; 2], t0: usize, errors: [&mut [f64]; 2])
     [result(asse, aover), result(bsse, bover)]
 }
 
-/// One run alone: [`simulate_n`] with the run's orders.
-pub(super) fn simulate_one(r: &Run, t0: usize) -> f64 {
-    macro_rules! go {
-        ($na:literal, $nb:literal) => {
-            simulate_n::<$na, $nb>(
-                r.y,
-                r.mv,
-                r.nk,
-                &std::array::from_fn(|i| r.a[i]),
-                &std::array::from_fn(|j| r.b[j]),
-                r.c,
-                t0,
-                None,
-                r.bound,
-            )
-        };
-    }
-    match (r.na, r.nb) {
-        (0, 1) => go!(0, 1),
-        (0, 2) => go!(0, 2),
-        (1, 1) => go!(1, 1),
-        (1, 2) => go!(1, 2),
-        (2, 1) => go!(2, 1),
-        (2, 2) => go!(2, 2),
-        _ => unreachable!("orders are at most 2"),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identify::simulate::simulate_sse;
+    use crate::identify::simulate::{simulate_run, simulate_sse};
     use crate::identify::Structure;
     use proptest::prelude::*;
 
@@ -220,7 +177,9 @@ mod tests {
             n in 40usize..300,
             orders in prop::array::uniform2((0usize..=2, 1usize..=2, 1usize..=3)),
             coef in prop::array::uniform2(prop::array::uniform5(-1.2f64..1.2)),
-            share in prop::array::uniform2(prop::sample::select(vec![0.0, 0.3, 0.9, 1.0, 2.0, f64::INFINITY])),
+            share in prop::array::uniform2(
+                prop::sample::select(vec![0.0, 0.3, 0.9, 1.0, 2.0, f64::INFINITY]),
+            ),
         ) {
             let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
             let mut next = || {
@@ -232,28 +191,31 @@ mod tests {
             let y: Vec<f64> = (0..n).map(|_| next()).collect();
             let mv: Vec<f64> = (0..n).map(|_| 3.0 * next()).collect();
             let t0 = 5;
-            let alone = |i: usize, bound: f64| simulate_one(&run(&y, &mv, orders[i], coef[i], bound), t0);
+            let run_i = |i: usize, bound: f64| run(&y, &mv, orders[i], coef[i], bound);
+            let alone = |i: usize, bound: f64| simulate_run(&run_i(i, bound), t0, None);
             // bounds as shares of each run's whole error
             let bounds: Vec<f64> = (0..2).map(|i| {
                 let whole = alone(i, f64::INFINITY);
                 if share[i].is_infinite() { f64::INFINITY } else { share[i] * whole }
             }).collect();
-            let runs = [run(&y, &mv, orders[0], coef[0], bounds[0]), run(&y, &mv, orders[1], coef[1], bounds[1])];
+            let runs = [run_i(0, bounds[0]), run_i(1, bounds[1])];
             let pair = simulate_pair([&runs[0], &runs[1]], t0);
             for i in 0..2 {
                 prop_assert_eq!(pair[i].to_bits(), alone(i, bounds[i]).to_bits(), "run {}", i);
             }
             // unbounded, with the errors written: what a simulation alone gives and simulates
-            let free = [run(&y, &mv, orders[0], coef[0], f64::INFINITY), run(&y, &mv, orders[1], coef[1], f64::INFINITY)];
+            let free = [run_i(0, f64::INFINITY), run_i(1, f64::INFINITY)];
             let (mut ea, mut eb) = (Vec::new(), Vec::new());
             let sses = simulate_pair_errors([&free[0], &free[1]], t0, [&mut ea, &mut eb]);
             for (i, errors) in [ea, eb].iter().enumerate() {
                 let (na, nb, nk) = orders[i];
                 let s = Structure { integrating: false, na, nb, nk };
                 let mut sim = Vec::new();
-                let sse = simulate_sse(&y, &mv, s, &coef[i][..na], &coef[i][2..2 + nb], coef[i][4], t0, Some(&mut sim));
+                let (a, b, c) = (&coef[i][..na], &coef[i][2..2 + nb], coef[i][4]);
+                let sse = simulate_sse(&y, &mv, s, a, b, c, t0, Some(&mut sim));
                 prop_assert_eq!(sses[i].to_bits(), sse.to_bits(), "run {}", i);
-                let alone: Vec<u64> = y[t0..].iter().zip(&sim[t0..]).map(|(a, b)| (a - b).to_bits()).collect();
+                let alone: Vec<u64> =
+                    y[t0..].iter().zip(&sim[t0..]).map(|(a, b)| (a - b).to_bits()).collect();
                 let paired: Vec<u64> = errors.iter().map(|e| e.to_bits()).collect();
                 prop_assert_eq!(paired, alone, "run {}", i);
             }

@@ -3,7 +3,8 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use super::pair::{simulate_one, simulate_pair, Run};
+use super::pair::simulate_pair;
+use super::simulate::{simulate_run, Run};
 use super::*;
 
 /// The sums of a least-squares fit that involve the valve position.
@@ -324,7 +325,7 @@ pub fn costs_from_sums(
             }
             [i] => {
                 let r = runs[i].as_ref().unwrap();
-                costs[i] = simulate_one(r, t0);
+                costs[i] = simulate_run(r, t0, None);
             }
             _ => unreachable!("chunks of two"),
         }

@@ -17,22 +17,53 @@ pub(super) fn simulate_sse(
     t0: usize,
     out: Option<&mut Vec<f64>>,
 ) -> f64 {
+    let run = Run {
+        y,
+        mv,
+        nk: s.nk,
+        na: s.na,
+        nb: s.nb,
+        a: std::array::from_fn(|i| if i < s.na { a[i] } else { 0.0 }),
+        b: std::array::from_fn(|j| if j < s.nb { b[j] } else { 0.0 }),
+        c,
+        bound: f64::INFINITY,
+    };
+    simulate_run(&run, t0, out)
+}
+
+/// One output-error simulation: a fit's coefficients (orders at most 2; a missing order's are
+/// 0), its output and input, and the bound past which it stops (see [`simulate_n`]).
+#[derive(Clone, Copy)]
+pub(super) struct Run<'a> {
+    pub y: &'a [f64],
+    pub mv: &'a [f64],
+    pub nk: usize,
+    pub na: usize,
+    pub nb: usize,
+    pub a: [f64; 2],
+    pub b: [f64; 2],
+    pub c: f64,
+    pub bound: f64,
+}
+
+/// [`simulate_n`] with the run's orders.
+pub(super) fn simulate_run(r: &Run, t0: usize, out: Option<&mut Vec<f64>>) -> f64 {
     macro_rules! go {
         ($na:literal, $nb:literal) => {
             simulate_n::<$na, $nb>(
-                y,
-                mv,
-                s.nk,
-                &std::array::from_fn(|i| a[i]),
-                &std::array::from_fn(|j| b[j]),
-                c,
+                r.y,
+                r.mv,
+                r.nk,
+                &std::array::from_fn(|i| r.a[i]),
+                &std::array::from_fn(|j| r.b[j]),
+                r.c,
                 t0,
                 out,
-                f64::INFINITY,
+                r.bound,
             )
         };
     }
-    match (s.na, s.nb) {
+    match (r.na, r.nb) {
         (0, 1) => go!(0, 1),
         (0, 2) => go!(0, 2),
         (1, 1) => go!(1, 1),
