@@ -164,20 +164,9 @@ impl<'a> Nudges<'a> {
 
     /// `theta` with parameter `k` nudged, as a simulation to run.
     fn run(&self, theta: &[f64], k: usize) -> Run<'a> {
-        let (na, nb) = (self.s.na, self.s.nb);
         let mut t = theta.to_vec();
         t[k] += Self::step(theta, k);
-        Run {
-            y: self.y,
-            mv: self.mv,
-            nk: self.s.nk,
-            na,
-            nb,
-            a: std::array::from_fn(|i| if i < na { t[i] } else { 0.0 }),
-            b: std::array::from_fn(|j| if j < nb { t[na + j] } else { 0.0 }),
-            c: t[na + nb],
-            bound: f64::INFINITY,
-        }
+        Run::of(self.y, self.mv, self.s, &t, f64::INFINITY)
     }
 
     /// The Jacobian at `theta`, whose errors are `r`, into `jac` column by column; `false` when a

@@ -256,17 +256,7 @@ impl<'a> Prepared<'a> {
             (2, 2) => self.solve_n::<2, 2>(sums),
             _ => unreachable!("orders are checked when prepared"),
         }?;
-        Some(Run {
-            y: self.y,
-            mv,
-            nk: self.s.nk,
-            na,
-            nb,
-            a: std::array::from_fn(|i| if i < na { theta[i] } else { 0.0 }),
-            b: std::array::from_fn(|j| if j < nb { theta[na + j] } else { 0.0 }),
-            c: theta[na + nb],
-            bound,
-        })
+        Some(Run::of(self.y, mv, self.s, &theta, bound))
     }
 
     fn finish_n<const NA: usize, const NB: usize>(

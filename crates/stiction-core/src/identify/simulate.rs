@@ -17,18 +17,8 @@ pub(super) fn simulate_sse(
     t0: usize,
     out: Option<&mut Vec<f64>>,
 ) -> f64 {
-    let run = Run {
-        y,
-        mv,
-        nk: s.nk,
-        na: s.na,
-        nb: s.nb,
-        a: std::array::from_fn(|i| if i < s.na { a[i] } else { 0.0 }),
-        b: std::array::from_fn(|j| if j < s.nb { b[j] } else { 0.0 }),
-        c,
-        bound: f64::INFINITY,
-    };
-    simulate_run(&run, t0, out)
+    let theta: Vec<f64> = a.iter().chain(b).copied().chain([c]).collect();
+    simulate_run(&Run::of(y, mv, s, &theta, f64::INFINITY), t0, out)
 }
 
 /// One output-error simulation: a fit's coefficients (orders at most 2; a missing order's are
@@ -44,6 +34,25 @@ pub(super) struct Run<'a> {
     pub b: [f64; 2],
     pub c: f64,
     pub bound: f64,
+}
+
+impl<'a> Run<'a> {
+    /// The run of structure `s`'s parameters `theta` (a, then b, then the constant) on `y` and
+    /// `mv`, stopped past `bound`.
+    pub fn of(y: &'a [f64], mv: &'a [f64], s: Structure, theta: &[f64], bound: f64) -> Self {
+        let (na, nb) = (s.na, s.nb);
+        Self {
+            y,
+            mv,
+            nk: s.nk,
+            na,
+            nb,
+            a: std::array::from_fn(|i| if i < na { theta[i] } else { 0.0 }),
+            b: std::array::from_fn(|j| if j < nb { theta[na + j] } else { 0.0 }),
+            c: theta[na + nb],
+            bound,
+        }
+    }
 }
 
 /// [`simulate_n`] with the run's orders.
