@@ -290,33 +290,27 @@ impl<'a> Prepared<'a> {
 /// same data) on one valve trajectory `mv`, from each one's `sums`, each stopped over its bound:
 /// for each, what `fit_from_sums(sums, mv, bound)` gives as `sse_simulation` (infinite without a
 /// fit), bit for bit. The simulations run two at a time, side by side.
-pub fn costs_from_sums(
+pub(crate) fn costs_from_sums(
     prepared: &[&Prepared],
     sums: &[ValveSums],
     mv: &[f64],
     bounds: &[f64],
 ) -> Vec<f64> {
-    let runs: Vec<Option<Run>> = prepared
-        .iter()
-        .zip(sums)
-        .zip(bounds)
-        .map(|((p, s), &b)| p.run(s, mv, b))
-        .collect();
     let mut costs = vec![f64::INFINITY; prepared.len()];
     // the fits that exist, in pairs of equally long outputs (a level and a change per sample
     // are equally long: both the record's length)
-    let live: Vec<usize> = (0..runs.len()).filter(|&i| runs[i].is_some()).collect();
+    let live: Vec<(usize, Run)> = prepared
+        .iter()
+        .zip(sums)
+        .zip(bounds)
+        .enumerate()
+        .filter_map(|(i, ((p, s), &b))| p.run(s, mv, b).map(|r| (i, r)))
+        .collect();
     let t0 = prepared.first().map_or(0, |p| p.t0);
     for pair in live.chunks(2) {
-        match *pair {
-            [i, j] => {
-                let (a, b) = (runs[i].as_ref().unwrap(), runs[j].as_ref().unwrap());
-                [costs[i], costs[j]] = simulate_pair([a, b], t0);
-            }
-            [i] => {
-                let r = runs[i].as_ref().unwrap();
-                costs[i] = simulate_run(r, t0, None);
-            }
+        match pair {
+            [(i, a), (j, b)] => [costs[*i], costs[*j]] = simulate_pair([a, b], t0),
+            [(i, r)] => costs[*i] = simulate_run(r, t0, None),
             _ => unreachable!("chunks of two"),
         }
     }
