@@ -208,26 +208,21 @@ impl Table {
     /// state such as Bad Input); an error for any other text.
     /// A unit written after every number of the column (`12.5 m3/h`, `45.2%`) is dropped
     /// ([`Table::unit`]).
-    pub fn numbers(&self, col: usize) -> Result<Vec<f64>> {
+    pub fn numbers<'t>(&'t self, col: usize) -> Result<Vec<f64>> {
         let name = &self.headers[col];
         let file = self.path.display();
         let mut out = Vec::with_capacity(self.len());
         let unit = self.unit(col);
-        let bare = |cell: &'_ str| -> String {
+        let bare = |cell: &'t str| -> &'t str {
             match &unit {
-                Some(u) => cell
-                    .strip_suffix(u.as_str())
-                    .unwrap_or(cell)
-                    .trim_end()
-                    .to_string(),
-                None => cell.to_string(),
+                Some(u) => cell.strip_suffix(u.as_str()).unwrap_or(cell).trim_end(),
+                None => cell,
             }
         };
         // digits grouped by thousands: the convention the column's unambiguous cells show
-        let cells: Vec<String> = (0..self.len()).map(|i| bare(self.cell(i, col))).collect();
-        let grouping = Grouping::of(cells.iter().map(String::as_str));
-        for (i, cell) in cells.iter().enumerate() {
-            let cell = cell.as_str();
+        let cells: Vec<&str> = (0..self.len()).map(|i| bare(self.cell(i, col))).collect();
+        let grouping = Grouping::of(cells.iter().copied());
+        for (i, &cell) in cells.iter().enumerate() {
             if is_missing(cell) {
                 out.push(f64::NAN);
                 continue;
