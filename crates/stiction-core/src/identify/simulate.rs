@@ -17,7 +17,11 @@ pub(super) fn simulate_sse(
     t0: usize,
     out: Option<&mut Vec<f64>>,
 ) -> f64 {
-    let theta: Vec<f64> = a.iter().chain(b).copied().chain([c]).collect();
+    // the parameters in one array on the stack (this runs in every refinement's iterations)
+    let mut theta = [0.0; 5];
+    theta[..s.na].copy_from_slice(&a[..s.na]);
+    theta[s.na..s.na + s.nb].copy_from_slice(&b[..s.nb]);
+    theta[s.na + s.nb] = c;
     simulate_run(&Run::of(y, mv, s, &theta, f64::INFINITY), t0, out)
 }
 
