@@ -18,6 +18,9 @@ pub enum Gate {
     PvCompressed,
     /// Too few distinct PV levels (value: distinct levels; limit: levels per 100 samples).
     PvQuantised,
+    /// PV held at its record's own extreme (a transmitter at the end of its range, or a clamp):
+    /// those samples are left out (value and limit: shares of the samples).
+    PvAtLimit,
     /// The controller in manual (value and limit: shares of the samples).
     ManualMode,
     /// Samples with a missing value (NaN), left out (value: share of the samples; limit 1, so it
@@ -42,6 +45,7 @@ impl Gate {
             Gate::PvFrozen => "pv_frozen",
             Gate::PvCompressed => "pv_compressed",
             Gate::PvQuantised => "pv_quantised",
+            Gate::PvAtLimit => "pv_at_limit",
             Gate::ManualMode => "manual_mode",
             Gate::MissingValues => "missing_values",
             Gate::SetpointChanges => "setpoint_changes",

@@ -46,47 +46,7 @@ pub(super) fn findings(
             )
         },
     )];
-    for (gate, count, what, limit) in [
-        (
-            Gate::ManualMode,
-            excluded.manual,
-            "in manual",
-            req.limits.manual_share,
-        ),
-        (
-            Gate::MissingValues,
-            excluded.missing,
-            "with a missing value",
-            1.0,
-        ),
-        (
-            Gate::Spikes,
-            excluded.spikes,
-            "in a spike (one to three samples of a signal far beyond its own range and back: a glitch, not the process)",
-            1.0,
-        ),
-        (
-            Gate::OpSaturated,
-            excluded.saturated,
-            "with OP at a limit (0 %, 100 % or pinned at its extreme)",
-            req.limits.saturated_share,
-        ),
-    ] {
-        if count > 0 {
-            let share = count as f64 / n.max(1) as f64;
-            out.push(finding(
-                gate,
-                share <= limit,
-                share,
-                limit,
-                format!(
-                    "{} {what} ({:.0} % of the record), left out",
-                    plural(count, "sample", "samples"),
-                    100.0 * share
-                ),
-            ));
-        }
-    }
+    out.extend(left_out_findings(excluded, n, req));
     if excluded.time_breaks > 0 {
         out.push(finding(
             Gate::TimeGaps,
@@ -143,6 +103,60 @@ pub(super) fn findings(
     out
 }
 
+/// A finding for each reason samples were left out (manual mode, missing values, spikes, OP or
+/// PV at a limit), of `n` samples in all.
+fn left_out_findings(excluded: &Excluded, n: usize, req: &DiagnoseRequest) -> Vec<Finding> {
+    let mut out = Vec::new();
+    for (gate, count, what, limit) in [
+        (
+            Gate::ManualMode,
+            excluded.manual,
+            "in manual",
+            req.limits.manual_share,
+        ),
+        (
+            Gate::MissingValues,
+            excluded.missing,
+            "with a missing value",
+            1.0,
+        ),
+        (
+            Gate::Spikes,
+            excluded.spikes,
+            "in a spike (one to three samples of a signal far beyond its own range and back: a glitch, not the process)",
+            1.0,
+        ),
+        (
+            Gate::OpSaturated,
+            excluded.saturated,
+            "with OP at a limit (0 %, 100 % or pinned at its extreme)",
+            req.limits.saturated_share,
+        ),
+        (
+            Gate::PvAtLimit,
+            excluded.pv_at_limit,
+            "with PV held at its extreme (a transmitter at the end of its range or a clamp: PV does not follow the process there)",
+            req.limits.saturated_share,
+        ),
+    ] {
+        if count > 0 {
+            let share = count as f64 / n.max(1) as f64;
+            out.push(finding(
+                gate,
+                share <= limit,
+                share,
+                limit,
+                format!(
+                    "{} {what} ({:.0} % of the record), left out",
+                    plural(count, "sample", "samples"),
+                    100.0 * share
+                ),
+            ));
+        }
+    }
+    out
+}
+
 fn left_out(x: &Excluded) -> String {
     let mut parts = Vec::new();
     if x.manual > 0 {
@@ -153,6 +167,9 @@ fn left_out(x: &Excluded) -> String {
     }
     if x.saturated > 0 {
         parts.push(format!("{} with OP at a limit", x.saturated));
+    }
+    if x.pv_at_limit > 0 {
+        parts.push(format!("{} with PV at a limit", x.pv_at_limit));
     }
     if x.spikes > 0 {
         parts.push(format!("{} in a spike", x.spikes));

@@ -1,5 +1,5 @@
-//! The usable stretches of a record: samples in automatic, with every signal present, OP off its
-//! limits, and a time axis without gaps. Setpoint changes do not split a stretch: they are the best
+//! The usable stretches of a record: samples in automatic, with every signal present, OP and PV
+//! off their limits, and a time axis without gaps. Setpoint changes do not split a stretch: they are the best
 //! excitation a loop gets.
 
 use super::request::DiagnoseRequest;
@@ -11,6 +11,8 @@ pub(super) struct Excluded {
     pub manual: usize,
     pub missing: usize,
     pub saturated: usize,
+    /// Samples with PV held at its record's own extreme ([`pv_at_limit`]).
+    pub pv_at_limit: usize,
     /// Samples in a spike of any signal ([`crate::quality::spikes`]).
     pub spikes: usize,
     /// Breaks of the time axis (gaps longer than the limit, or time not increasing).
@@ -21,11 +23,18 @@ pub(super) struct Excluded {
 /// limit we cannot see (a normalised or engineering-unit OP).
 const PINNED_RUN: usize = 3;
 
+/// A PV counts as held at a limit only where it otherwise repeats a value in at most this share
+/// of its samples: a measurement with noise never repeats exactly, while a quantised PV or one
+/// compressed by the historian repeats everywhere, its extremes too (their own gates and guards
+/// take care of them).
+const PV_REPEATS_ELSEWHERE: f64 = 0.05;
+
 /// The usable stretches `[start, end)`, in order, and what was left out.
 pub(super) fn usable(r: &Record, req: &DiagnoseRequest) -> (Vec<(usize, usize)>, Excluded) {
     let n = r.op.len();
     let mut excluded = Excluded::default();
     let saturated = saturated_samples(r.op, req.op_range);
+    let pv_limited = pv_at_limit(r.pv);
     let spiked = spiked_samples(r);
     let breaks = time_breaks(r.time, n, req.limits.gap_steps);
     excluded.time_breaks = breaks.iter().filter(|&&b| b).count();
@@ -46,6 +55,9 @@ pub(super) fn usable(r: &Record, req: &DiagnoseRequest) -> (Vec<(usize, usize)>,
             ok[k] = false;
         } else if saturated[k] {
             excluded.saturated += 1;
+            ok[k] = false;
+        } else if pv_limited[k] {
+            excluded.pv_at_limit += 1;
             ok[k] = false;
         }
     }
@@ -100,6 +112,43 @@ fn saturated_samples(op: &[f64], [lo_range, hi_range]: [f64; 2]) -> Vec<bool> {
             out[k..k + run].fill(true);
         }
         k += run;
+    }
+    out
+}
+
+/// Samples with PV held at its record's own extreme: runs of at least [`PINNED_RUN`] equal values
+/// at the highest or lowest PV, in a PV that otherwise hardly repeats itself
+/// ([`PV_REPEATS_ELSEWHERE`]). A transmitter at the end of its range (or a clamp in the control
+/// system) reads the same value while the process goes on beyond it: OP winds up while PV stays
+/// put and then moves OP's way, which is what a sticky valve's stick and slip look like, and no
+/// linear loop explains the clipped PV, which a band then seems to.
+pub(super) fn pv_at_limit(pv: &[f64]) -> Vec<bool> {
+    let n = pv.len();
+    let mut out = vec![false; n];
+    let finite = pv.iter().copied().filter(|v| v.is_finite());
+    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    if hi <= lo {
+        return out;
+    }
+    let mut repeats_elsewhere = 0usize;
+    let mut k = 0;
+    while k < n {
+        let v = pv[k];
+        let mut run = 1;
+        while k + run < n && pv[k + run] == v {
+            run += 1;
+        }
+        if (v == lo || v == hi) && run >= PINNED_RUN {
+            out[k..k + run].fill(true);
+        } else {
+            repeats_elsewhere += run - 1;
+        }
+        k += run;
+    }
+    if repeats_elsewhere as f64 > PV_REPEATS_ELSEWHERE * n as f64 {
+        out.fill(false);
     }
     out
 }
@@ -159,10 +208,40 @@ mod tests {
                 manual: 5,
                 missing: 1,
                 saturated: 3,
+                pv_at_limit: 0,
                 spikes: 0,
                 time_breaks: 1
             }
         );
+    }
+
+    /// A PV held at its highest value (a transmitter at the end of its range) is left out and
+    /// splits the record; a PV that repeats itself everywhere (quantised or compressed), or a
+    /// noisy PV that touches its extreme once, is not held at a limit.
+    #[test]
+    fn a_pv_held_at_its_extreme_is_left_out() {
+        let n = 60;
+        let op: Vec<f64> = (0..n).map(|k| 50.0 + (k % 5) as f64).collect();
+        let noisy = |k: usize| 40.0 + ((k * 37) % 17) as f64 * 0.1;
+        let mut pv: Vec<f64> = (0..n).map(noisy).collect();
+        pv[20..30].fill(100.0);
+        let (s, ex) = usable(&record(&op, &pv), &DiagnoseRequest::default());
+        assert_eq!(s, vec![(0, 20), (30, 60)]);
+        assert_eq!(ex.pv_at_limit, 10);
+        // at its lowest too
+        pv[20..30].fill(0.0);
+        assert_eq!(pv_at_limit(&pv).iter().filter(|&&l| l).count(), 10);
+        // a single sample at the extreme is a measurement's peak, not a limit
+        pv[20..30]
+            .iter_mut()
+            .enumerate()
+            .for_each(|(i, v)| *v = noisy(i));
+        pv[25] = 100.0;
+        assert!(pv_at_limit(&pv).iter().all(|&l| !l));
+        // a quantised PV repeats at every level, its extremes too
+        let quantised: Vec<f64> = (0..n).map(|k| ((k / 4) % 3) as f64).collect();
+        assert!(pv_at_limit(&quantised).iter().all(|&l| !l));
+        assert!(pv_at_limit(&[1.0; 10]).iter().all(|&l| !l));
     }
 
     #[test]
