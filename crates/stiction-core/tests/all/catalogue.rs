@@ -6,7 +6,7 @@ use stiction_core::sim::catalogue::{
     self, catalogue, find, generate, issue14_example, loop_id, BenchmarkLoop, LoopClass,
     NoiseLevel, Set, Suite, Truth, MIN_SLIPS,
 };
-use stiction_core::sim::Characteristic;
+use stiction_core::sim::{Characteristic, Signal};
 
 fn count(ls: &[BenchmarkLoop], f: impl Fn(&BenchmarkLoop) -> bool) -> usize {
     ls.iter().filter(|l| f(l)).count()
@@ -83,6 +83,9 @@ fn look_alikes_have_their_feature() {
                 assert!(s.disturbance.is_some() || s.load.is_some())
             }
             LoopClass::SlowLongDelay => assert!(s.process.delay() >= 40.0),
+            LoopClass::LoadSteps => {
+                assert!(matches!(s.load, Some(Signal::RandomSteps { .. })))
+            }
             _ => {}
         }
         assert_eq!(l.truth == Truth::NotSticky, healthy_valve, "{}", l.id);

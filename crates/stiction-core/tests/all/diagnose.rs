@@ -700,3 +700,64 @@ fn a_hidden_valve_ratio_under_the_threshold_is_drawn_once() {
     assert!(h.ratio < 60.0, "{h:?}");
     assert_eq!(h.draws, vec![h.ratio], "{h:?}");
 }
+
+#[test]
+fn a_fit_that_mirrors_the_controller_casts_no_stiction_vote() {
+    // routine-c-0490 of the plant catalogue (calibration set): a healthy pressure valve whose
+    // load steps OP does not explain; the linear fit reads PV from OP through the controller's own
+    // law (a process gain near zero), a band gained on it (test ratio 360) and the loop was called
+    // sticky before the loop gain was checked
+    let d = judge_catalogue("routine-c-0490");
+    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let m = model_family(&d);
+    assert_eq!(m.vote, Vote::Undetermined, "{}", m.note);
+    let g = m.model.as_ref().unwrap().loop_gain.unwrap();
+    assert!(
+        g < stiction_core::diagnose::evidence::model::MIN_LOOP_GAIN,
+        "{g}"
+    );
+    assert!(m.note.contains("loop gain"), "{}", m.note);
+    // a sticky valve's fit keeps its vote: the loop gain it implies is the loop's
+    let sticky = run(2.0, |_| {});
+    let d = diagnose(&record(&sticky), &DiagnoseRequest::default()).unwrap();
+    let m = model_family(&d);
+    assert!(
+        m.model.as_ref().unwrap().loop_gain.unwrap() > 0.1,
+        "{}",
+        m.note
+    );
+}
+
+#[test]
+fn a_pv_held_at_its_transmitters_limit_is_left_out() {
+    // a healthy loop whose PV reads 100 % while the process runs above it: OP winds up while PV
+    // stays put, then PV moves OP's way, as a sticky valve's stick and slip would
+    let mut l = run(0.0, |cl| {
+        cl.samples = 3000;
+        cl.setpoint = Signal::Constant { value: 95.0 };
+        cl.op0 = 50.0;
+        cl.load = Some(Signal::Steps {
+            amplitude: 8.0,
+            hold: 400.0,
+            offset: 0.0,
+            seed: 3,
+        });
+    });
+    let clipped = l.pv.iter().filter(|&&v| v >= 100.0).count();
+    for v in &mut l.pv {
+        *v = v.min(100.0);
+    }
+    assert!(clipped > 30, "the PV must reach its limit: {clipped}");
+    let d = diagnose(&record(&l), &quick()).unwrap();
+    let f = d
+        .quality
+        .iter()
+        .find(|f| f.gate == Gate::PvAtLimit)
+        .unwrap_or_else(|| panic!("{:#?}", d.quality));
+    assert!(
+        f.message.contains("PV held at its extreme"),
+        "{}",
+        f.message
+    );
+    assert!(d.analysed[1] - d.analysed[0] <= l.pv.len() - clipped);
+}

@@ -38,11 +38,14 @@ pub enum LoopClass {
     SaturatedOp,
     /// The inner loop of a cascade: its setpoint moves with the outer loop.
     CascadeInner,
+    /// Healthy valve with a load that changes in steps OP does not explain (a feed rate or an
+    /// upstream pressure that jumps): PV kicks at each step while OP answers it.
+    LoadSteps,
 }
 
 impl LoopClass {
     /// Every class, in catalogue order.
-    pub const ALL: [LoopClass; 14] = [
+    pub const ALL: [LoopClass; 15] = [
         Self::StenmanValve,
         Self::KanoValve,
         Self::HeValve,
@@ -57,6 +60,7 @@ impl LoopClass {
         Self::NearUnstable,
         Self::SaturatedOp,
         Self::CascadeInner,
+        Self::LoadSteps,
     ];
 
     /// The truth a verdict on this class is judged against.
@@ -85,6 +89,7 @@ impl LoopClass {
             Self::NearUnstable => "near_unstable",
             Self::SaturatedOp => "saturated_op",
             Self::CascadeInner => "cascade_inner",
+            Self::LoadSteps => "load_steps",
         }
     }
 }

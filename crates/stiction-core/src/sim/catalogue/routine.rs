@@ -15,7 +15,8 @@
 //! effective delays); aggressive tuning: Ti half to one SIMC Ti, Kc 0.55-0.8 of the ultimate gain.
 //! Excitation: setpoint steps within ±1-5 % held 5-12 % of the window and up to three times
 //! that (30 %), a load drift spreading 2-6 % (25 %), a load ramp of 2-8 % over the window (20 %),
-//! steps and drift (25 %). OP0 25-75 %.
+//! steps and drift (25 %). OP0 25-75 %. Load steps (a look-alike): the load, in place of any
+//! drift or ramp, steps within ±2-8 % and holds 5-12 % of the window and up to three times that.
 
 use super::draw::Draw;
 use super::plant::{load_drift, noise, valve, Built};
@@ -174,6 +175,22 @@ fn look_alike(class: LoopClass, cl: &mut ClosedLoop, window: f64, d: &mut Draw) 
                 note.push_str(&format!(", OP too ({deviation:.2} %)"));
             }
             notes.push(note.to_lowercase());
+        }
+        LoopClass::LoadSteps => {
+            let amplitude = d.uniform(2.0, 8.0);
+            let min_hold = window * d.uniform(0.05, 0.12);
+            cl.load = Some(Signal::RandomSteps {
+                amplitude,
+                min_hold,
+                max_hold: min_hold * d.uniform(1.5, 3.0),
+                offset: 0.0,
+                seed: d.seed(),
+            });
+            notes.push(format!(
+                "load steps within ±{amplitude:.1} % held {:.0}-{:.0} min, in place of any other load",
+                min_hold / 60.0,
+                min_hold * 3.0 / 60.0
+            ));
         }
         LoopClass::ExternalOscillation => {
             let lo = (8.0 * cl.ts).max(30.0);
