@@ -93,27 +93,40 @@ fn spiked_samples(r: &Record) -> Vec<bool> {
 /// Samples with OP at a limit: at the ends of `op_range` when OP stays within it, or held at the
 /// record's own extreme for a while.
 fn saturated_samples(op: &[f64], [lo_range, hi_range]: [f64; 2]) -> Vec<bool> {
-    let finite = op.iter().copied().filter(|v| v.is_finite());
-    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-        (a.min(v), b.max(v))
-    });
+    let (lo, hi) = extremes(op);
     let within = lo >= lo_range && hi <= hi_range;
     let mut out = vec![false; op.len()];
-    let mut k = 0;
-    while k < op.len() {
+    for (k, run) in runs(op) {
         let v = op[k];
-        let mut run = 1;
-        while k + run < op.len() && op[k + run] == v {
-            run += 1;
-        }
         let at_range_limit = within && (v <= lo_range || v >= hi_range);
         let pinned = hi > lo && (v == lo || v == hi) && run >= PINNED_RUN;
         if at_range_limit || pinned {
             out[k..k + run].fill(true);
         }
-        k += run;
     }
     out
+}
+
+/// The lowest and highest finite values of `x` (infinite the wrong way round without any).
+fn extremes(x: &[f64]) -> (f64, f64) {
+    let finite = x.iter().copied().filter(|v| v.is_finite());
+    finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    })
+}
+
+/// The runs of equal values of `x`: each one's first sample and length, in order.
+fn runs(x: &[f64]) -> impl Iterator<Item = (usize, usize)> + '_ {
+    let mut k = 0;
+    std::iter::from_fn(move || {
+        let v = *x.get(k)?;
+        let start = k;
+        k += 1;
+        while k < x.len() && x[k] == v {
+            k += 1;
+        }
+        Some((start, k - start))
+    })
 }
 
 /// Samples with PV held at its record's own extreme: runs of at least [`PINNED_RUN`] equal values
@@ -125,27 +138,17 @@ fn saturated_samples(op: &[f64], [lo_range, hi_range]: [f64; 2]) -> Vec<bool> {
 pub(super) fn pv_at_limit(pv: &[f64]) -> Vec<bool> {
     let n = pv.len();
     let mut out = vec![false; n];
-    let finite = pv.iter().copied().filter(|v| v.is_finite());
-    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-        (a.min(v), b.max(v))
-    });
+    let (lo, hi) = extremes(pv);
     if hi <= lo {
         return out;
     }
     let mut repeats_elsewhere = 0usize;
-    let mut k = 0;
-    while k < n {
-        let v = pv[k];
-        let mut run = 1;
-        while k + run < n && pv[k + run] == v {
-            run += 1;
-        }
-        if (v == lo || v == hi) && run >= PINNED_RUN {
+    for (k, run) in runs(pv) {
+        if (pv[k] == lo || pv[k] == hi) && run >= PINNED_RUN {
             out[k..k + run].fill(true);
         } else {
             repeats_elsewhere += run - 1;
         }
-        k += run;
     }
     if repeats_elsewhere as f64 > PV_REPEATS_ELSEWHERE * n as f64 {
         out.fill(false);
