@@ -717,6 +717,13 @@ fn a_fit_that_mirrors_the_controller_casts_no_stiction_vote() {
         "{g}"
     );
     assert!(m.note.contains("loop gain"), "{}", m.note);
+    assert!(m.model.as_ref().unwrap().fit_mirrors_controller);
+    // routine-c-0507: the withdrawn vote was the only one; the verdict says so instead of calling
+    // a loop that load steps move "not excited enough"
+    let d = judge_catalogue("routine-c-0507");
+    assert_eq!(d.verdict, Verdict::Undetermined, "{:?}", d.reason);
+    let reason = d.reason.unwrap();
+    assert!(reason.contains("controller's own law"), "{reason}");
     // a sticky valve's fit keeps its vote: the loop gain it implies is the loop's
     let sticky = run(2.0, |_| {});
     let d = diagnose(&record(&sticky), &DiagnoseRequest::default()).unwrap();

@@ -210,6 +210,14 @@ pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
             None,
             Some(leaning_reason(&leaning)),
         ),
+        (true, true) if mirrors_controller(families) => (
+            Verdict::Undetermined,
+            None,
+            Some(
+                "the loop moves, but only the closed-loop fit could judge it, and it explains PV through the controller's own law (a load OP does not explain moves the loop, not the setpoint): its gain with a band is no vote, and no other family votes"
+                    .to_string(),
+            ),
+        ),
         (true, true) if oscillating => (
             Verdict::Undetermined,
             None,
@@ -282,6 +290,13 @@ pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
         next_step: next_step(verdict, confidence, families, motion),
         evidence,
     }
+}
+
+/// Whether the closed-loop fit's stiction vote was withdrawn because it mirrors the controller.
+fn mirrors_controller(families: &[FamilyEvidence]) -> bool {
+    families.iter().any(|f| {
+        f.family == Family::Model && f.model.as_ref().is_some_and(|m| m.fit_mirrors_controller)
+    })
 }
 
 /// Why a record whose families measured something but none voted is undetermined: which lean

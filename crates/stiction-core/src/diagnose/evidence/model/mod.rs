@@ -182,6 +182,10 @@ pub struct ModelEvidence {
     /// input of fixed period, and over whole periods it gained nothing ([`FORCED_REGULARITY`]).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub gain_in_a_clock_regular_cycle: bool,
+    /// The stiction vote was withdrawn: the fitted process and the identified PI make a loop
+    /// gain under [`MIN_LOOP_GAIN`], so the fit explains PV through the controller's own law.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub fit_mirrors_controller: bool,
 }
 
 /// The statistics of a comparison: shares of the compared output's variance above its noise.
@@ -308,6 +312,7 @@ impl EvidenceFamily for Model {
         // a fit that mirrors the controller says nothing about the valve
         if let Some(w) = mirrors_controller(ctx, &evidence, vote, &why) {
             (vote, strength, why) = (Vote::Undetermined, 0.0, w);
+            evidence.fit_mirrors_controller = true;
         }
         // measured, between the thresholds: the fit gains more than most healthy loops give
         let leans = (evidence.gain_in_a_clock_regular_cycle
@@ -374,6 +379,7 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
         levels: None,
         cycle_cancelled: None,
         gain_in_a_clock_regular_cycle: false,
+        fit_mirrors_controller: false,
     }
 }
 
