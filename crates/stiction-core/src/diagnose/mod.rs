@@ -19,6 +19,7 @@ mod gates;
 pub mod oscillation;
 mod request;
 mod result;
+mod saturation;
 mod stretch;
 mod verdict;
 mod windows;
@@ -210,6 +211,9 @@ pub fn diagnose_checked(
         seconds: 0.0,
     };
     if e - s < req.min_samples {
+        if let Some((family, osc)) = saturation::bounded(r, req, e - s) {
+            return Ok(saturation_bound(d, family, osc, r.sp, req, started));
+        }
         let reason = too_short(&d.quality, e - s, req);
         let next_step = "use a longer record in automatic with every signal present".into();
         return Ok(unjudged(d, reason, next_step, started));
@@ -234,6 +238,33 @@ pub fn diagnose_checked(
     d.oscillation = Some(osc);
     d.seconds = started.elapsed().as_secs_f64();
     Ok(d)
+}
+
+/// `d` judged on the loop family's saturation rule alone, over the whole record
+/// ([`saturation::bounded`]).
+fn saturation_bound(
+    mut d: Diagnosis,
+    family: FamilyEvidence,
+    osc: Osc,
+    sp: Option<&[f64]>,
+    req: &DiagnoseRequest,
+    started: Instant,
+) -> Diagnosis {
+    let families = vec![family];
+    let decision = verdict::decide(&families, &verdict::Motion::of(&osc, req.ts, sp));
+    d.verdict = decision.verdict;
+    d.confidence = decision.confidence;
+    d.reason = decision.reason;
+    d.evidence = decision.evidence;
+    d.next_step = decision.next_step;
+    d.families = families;
+    d.oscillation = Some(osc);
+    d.warnings.push(format!(
+        "OP's limits cut the record into stretches too short to judge the valve (the longest {} samples): only the saturation was judged, over the whole record",
+        d.stretches.iter().map(|s| s[1] - s[0]).max().unwrap_or(0)
+    ));
+    d.seconds = started.elapsed().as_secs_f64();
+    d
 }
 
 /// `d` as `insufficient_data` (its default verdict) for `reason`, with the next step.

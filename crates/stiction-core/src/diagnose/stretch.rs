@@ -92,7 +92,7 @@ fn spiked_samples(r: &Record) -> Vec<bool> {
 
 /// Samples with OP at a limit: at the ends of `op_range` when OP stays within it, or held at the
 /// record's own extreme for a while.
-fn saturated_samples(op: &[f64], [lo_range, hi_range]: [f64; 2]) -> Vec<bool> {
+pub(super) fn saturated_samples(op: &[f64], [lo_range, hi_range]: [f64; 2]) -> Vec<bool> {
     let (lo, hi) = extremes(op);
     let within = lo >= lo_range && hi <= hi_range;
     let mut out = vec![false; op.len()];

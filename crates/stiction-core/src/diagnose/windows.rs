@@ -43,7 +43,19 @@ pub(super) fn judge_windows(
             period: None,
             votes: Vec::new(),
         };
-        if e - s >= req.min_samples {
+        if e - s < req.min_samples {
+            // OP's limits cut the window short: the loop family's saturation rule over it
+            if let Some((family, osc)) = super::saturation::bounded(&sub, req, e - s) {
+                let families = [family];
+                let motion = super::verdict::Motion::of(&osc, req.ts, sub.sp);
+                let decision = super::verdict::decide(&families, &motion);
+                v.verdict = decision.verdict;
+                v.confidence = decision.confidence;
+                v.reason = decision.reason;
+                v.period = osc.period;
+                v.votes = families.iter().map(|f| (f.family, f.vote)).collect();
+            }
+        } else {
             let judged = sub.slice(s, e);
             match super::gates::still(judged.op, judged.pv) {
                 Some((reason, _)) => v.reason = Some(reason),

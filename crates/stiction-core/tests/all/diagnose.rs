@@ -768,3 +768,32 @@ fn a_pv_held_at_its_transmitters_limit_is_left_out() {
     );
     assert!(d.analysed[1] - d.analysed[0] <= l.pv.len() - clipped);
 }
+
+#[test]
+fn a_cycle_that_saturation_cuts_short_is_judged_by_its_saturation() {
+    // fast-b-0180 of the plant catalogue: a healthy flow valve near 0 % whose load oscillation
+    // drives OP to its limit every cycle; the samples at the limit are left out, the longest
+    // stretch left has 93 samples, and the record was `insufficient_data`
+    let d = judge_catalogue("fast-b-0180");
+    assert_eq!(d.verdict, Verdict::NoStiction, "{:?}", d.reason);
+    assert_eq!(d.families.len(), 1);
+    let f = &d.families[0];
+    assert_eq!((f.family, f.vote), (Family::Loop, Vote::NoStiction));
+    assert!(f.note.contains("saturation bounds the cycle"), "{}", f.note);
+    assert!(d.next_step.contains("limits"), "{}", d.next_step);
+    assert!(d.warnings.iter().any(|w| w.contains("too short")));
+    // windows use the same rule
+    let l = stiction_core::sim::catalogue::find("fast-b-0180").unwrap();
+    let req = DiagnoseRequest {
+        ts: l.ts(),
+        window: Some(500),
+        ..DiagnoseRequest::default()
+    };
+    let d = diagnose(&record(&l.data), &req).unwrap();
+    assert!(d.windows.iter().all(|w| w.verdict == Verdict::NoStiction));
+    // a record cut short without a cycle that reaches the limits stays unjudged
+    let mut quiet = run(0.0, |cl| cl.samples = 150);
+    quiet.op[60] = 100.0;
+    let d = diagnose(&record(&quiet), &DiagnoseRequest::default()).unwrap();
+    assert_eq!(d.verdict, Verdict::InsufficientData);
+}

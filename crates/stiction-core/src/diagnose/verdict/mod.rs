@@ -170,7 +170,6 @@ impl Motion {
 
 /// Decide from the families' votes and what the oscillation shows (`motion`).
 pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
-    let oscillating = motion.oscillating;
     let evidence = evidence_lines(families);
     let of =
         |v: Vote| -> Vec<&FamilyEvidence> { families.iter().filter(|f| f.vote == v).collect() };
@@ -205,39 +204,10 @@ pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
         .filter(|f| f.vote == Vote::Undetermined && f.leans.is_some())
         .collect();
     let (verdict, confidence, reason) = match (pro.is_empty(), con.is_empty()) {
-        (true, true) if !leaning.is_empty() => (
-            Verdict::Undetermined,
-            None,
-            Some(leaning_reason(&leaning)),
-        ),
-        (true, true) if mirrors_controller(families) => (
-            Verdict::Undetermined,
-            None,
-            Some(
-                "the loop moves, but only the closed-loop fit could judge it, and it explains PV through the controller's own law (a load OP does not explain moves the loop, not the setpoint): its gain with a band is no vote, and no other family votes"
-                    .to_string(),
-            ),
-        ),
-        (true, true) if oscillating => (
-            Verdict::Undetermined,
-            None,
-            Some(
-                "the loop oscillates but no family of evidence names the cause: the cycle is regular and near-sinusoidal, the fits with and without stiction alike, and the linear loop could sustain it by itself"
-                    .to_string(),
-            ),
-        ),
-        (true, true) => (
-            Verdict::InsufficientData,
-            None,
-            Some(match motion.unresolved_cycle {
-                Some((period, samples)) => format!(
-                    "no family of evidence could judge this record: the control error cycles regularly every {period:.0} s, only {samples:.1} samples a cycle, \
-                     which passes for measurement noise here; a sticky valve's cycle and a loop at its stability limit look alike at this sampling"
-                ),
-                None => "no family of evidence could judge this record: the loop is not excited enough (OP and PV hardly move above their noise, no oscillation)"
-                    .to_string(),
-            }),
-        ),
+        (true, true) => {
+            let (verdict, reason) = without_votes(families, &leaning, motion);
+            (verdict, None, Some(reason))
+        }
         (false, true) if strongest(&pro) < DECIDES => (
             Verdict::Undetermined,
             None,
@@ -246,16 +216,8 @@ pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
                 names(&pro)
             )),
         ),
-        (false, true) => (
-            Verdict::Stiction,
-            Some(combined(pro.iter().map(w))),
-            None,
-        ),
-        (true, false) => (
-            Verdict::NoStiction,
-            Some(combined(con.iter().map(w))),
-            None,
-        ),
+        (false, true) => (Verdict::Stiction, Some(combined(pro.iter().map(w))), None),
+        (true, false) => (Verdict::NoStiction, Some(combined(con.iter().map(w))), None),
         (false, false) => {
             let (p, c) = (total(&pro), total(&con));
             if p >= DOMINANCE * c && strongest(&con) <= WEAK_DISSENT && strongest(&pro) >= DECIDES {
@@ -290,6 +252,41 @@ pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
         next_step: next_step(verdict, confidence, families, motion),
         evidence,
     }
+}
+
+/// The verdict and reason when no family votes: leaning evidence, a withdrawn fit, an
+/// oscillation nobody explains, or a record nobody could judge.
+fn without_votes(
+    families: &[FamilyEvidence],
+    leaning: &[&FamilyEvidence],
+    motion: &Motion,
+) -> (Verdict, String) {
+    if !leaning.is_empty() {
+        return (Verdict::Undetermined, leaning_reason(leaning));
+    }
+    if mirrors_controller(families) {
+        return (
+            Verdict::Undetermined,
+            "the loop moves, but only the closed-loop fit could judge it, and it explains PV through the controller's own law (a load OP does not explain moves the loop, not the setpoint): its gain with a band is no vote, and no other family votes"
+                .to_string(),
+        );
+    }
+    if motion.oscillating {
+        return (
+            Verdict::Undetermined,
+            "the loop oscillates but no family of evidence names the cause: the cycle is regular and near-sinusoidal, the fits with and without stiction alike, and the linear loop could sustain it by itself"
+                .to_string(),
+        );
+    }
+    let reason = match motion.unresolved_cycle {
+        Some((period, samples)) => format!(
+            "no family of evidence could judge this record: the control error cycles regularly every {period:.0} s, only {samples:.1} samples a cycle, \
+             which passes for measurement noise here; a sticky valve's cycle and a loop at its stability limit look alike at this sampling"
+        ),
+        None => "no family of evidence could judge this record: the loop is not excited enough (OP and PV hardly move above their noise, no oscillation)"
+            .to_string(),
+    };
+    (Verdict::InsufficientData, reason)
 }
 
 /// Whether the closed-loop fit's stiction vote was withdrawn because it mirrors the controller.
@@ -367,6 +364,9 @@ fn next_step(
             } else {
                 "valve travel test recommended (small OP steps in manual, watching PV or the valve position) to confirm before maintenance".into()
             }
+        }
+        Verdict::NoStiction if voted(Family::Loop, Vote::NoStiction) => {
+            "the valve is not the cause here: OP reaches its limits in the cycle (a disturbance larger than the valve can take, a valve too small for its duty, or tuning); judge the valve again once OP stays off its limits".into()
         }
         Verdict::NoStiction if op_does_not_drive => {
             "look upstream: OP does not drive this variation (an external disturbance or an interacting loop)".into()

@@ -77,6 +77,8 @@ pub const MIN_MARGIN: f64 = 0.8;
 pub const LIMIT_NEAR: f64 = 0.01;
 /// ... when this share of the cycles reach it.
 pub const LIMIT_CYCLES: f64 = 0.25;
+/// Strength of the vote against stiction when OP reaches a limit in [`LIMIT_CYCLES`] of the cycles.
+pub const SATURATION_STRENGTH: f64 = 0.6;
 /// An amplitude that changes by this much over the record, or scatters this much from cycle to
 /// cycle (standard deviation of its logarithm), is reported as a linear loop's (not a vote: on
 /// plant data stick-slip cycles wander too).

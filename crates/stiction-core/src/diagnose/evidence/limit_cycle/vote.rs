@@ -3,8 +3,8 @@
 use super::{
     LoopEvidence, StictionBasis, FREE_RUNNING, FULL_LAG, LIMIT_CYCLES, LINEAR_GAIN, LINEAR_LAG,
     MAX_CONTROLLER_RESIDUAL, MAX_DISTANCE, MAX_LAG, MAX_RESIDUAL, MIN_LAG, MIN_MARGIN, NO_SETPOINT,
-    SELF_SUSTAINED, STEADY_CYCLES, STEADY_SCATTER, STEADY_SCATTER_LONG, UNSTEADY_CHANGE,
-    UNSTEADY_SCATTER,
+    SATURATION_STRENGTH, SELF_SUSTAINED, STEADY_CYCLES, STEADY_SCATTER, STEADY_SCATTER_LONG,
+    UNSTEADY_CHANGE, UNSTEADY_SCATTER,
 };
 use crate::diagnose::evidence::{Family, FamilyEvidence};
 use crate::diagnose::result::Vote;
@@ -60,7 +60,7 @@ fn ballot(e: &LoopEvidence) -> Ballot {
     if e.op_at_limit >= LIMIT_CYCLES {
         return (
             Vote::NoStiction,
-            0.6,
+            SATURATION_STRENGTH,
             "OP reaches a limit of its range in the cycle: saturation bounds it".into(),
             None,
         );
