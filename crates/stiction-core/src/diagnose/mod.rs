@@ -259,10 +259,24 @@ fn saturation_bound(
     d.next_step = decision.next_step;
     d.families = families;
     d.oscillation = Some(osc);
+    let [s, e] = d.analysed;
+    for f in d
+        .quality
+        .iter_mut()
+        .filter(|f| f.gate == Gate::RecordLength)
+    {
+        f.message = format!(
+            "the longest usable stretch, samples {s} to {e}, is too short for the families ({} of {} samples, of {} usable stretches); the whole record was read for OP's saturation",
+            e - s,
+            d.samples,
+            d.stretches.len()
+        );
+    }
     d.warnings.push(format!(
         "OP's limits cut the record into stretches too short to judge the valve (the longest {} samples): only the saturation was judged, over the whole record",
-        d.stretches.iter().map(|s| s[1] - s[0]).max().unwrap_or(0)
+        e - s
     ));
+    d.analysed = [0, d.samples];
     d.seconds = started.elapsed().as_secs_f64();
     d
 }

@@ -782,6 +782,18 @@ fn a_cycle_that_saturation_cuts_short_is_judged_by_its_saturation() {
     assert!(f.note.contains("saturation bounds the cycle"), "{}", f.note);
     assert!(d.next_step.contains("limits"), "{}", d.next_step);
     assert!(d.warnings.iter().any(|w| w.contains("too short")));
+    // the verdict reads the whole record, and the record-length finding says so
+    assert_eq!(d.analysed, [0, d.samples]);
+    let length = d
+        .quality
+        .iter()
+        .find(|f| f.gate == Gate::RecordLength)
+        .unwrap();
+    assert!(
+        length.message.contains("whole record"),
+        "{}",
+        length.message
+    );
     // windows use the same rule
     let l = stiction_core::sim::catalogue::find("fast-b-0180").unwrap();
     let req = DiagnoseRequest {

@@ -121,8 +121,8 @@ pub(super) fn trends(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>)
     let t = series::time_axis(data);
     let note = (s > 0 || e < d.samples).then(|| {
         format!(
-            "The diagnosis uses samples {s} to {e} (t = {} to {} s); the rest of the record is in \
-             manual, or has another setpoint.",
+            "The diagnosis uses samples {s} to {e} (t = {} to {} s); the rest of the record is left \
+             out (manual mode, OP or PV at a limit, gaps or bad data: see Data quality).",
             num(t.get(s).copied().unwrap_or(0.0)),
             num(t.get(e.saturating_sub(1)).copied().unwrap_or(0.0))
         )

@@ -151,12 +151,17 @@ fn meta(data: &LoopData, d: &Diagnosis) -> String {
         } else {
             ""
         },
-        if data.sp.is_some() {
-            " with a constant setpoint"
-        } else {
-            ""
-        },
+        setpoint_words(data.sp, [s, e]),
     )
+}
+
+/// What the setpoint does over the analysed samples `[s, e)`, for the page's header.
+fn setpoint_words(sp: Option<&[f64]>, [s, e]: [usize; 2]) -> &'static str {
+    match sp.and_then(|sp| sp.get(s..e)) {
+        Some(sp) if sp.windows(2).all(|w| w[0] == w[1]) => " with a constant setpoint",
+        Some(_) => " with its setpoint changes",
+        None => "",
+    }
 }
 
 fn columns(c: &ColumnNames, data: &LoopData) -> Vec<Rich> {
@@ -226,5 +231,24 @@ fn verdict_box(d: &Diagnosis) -> VerdictBox {
             source: b.source.words(),
         }),
         next_step: d.next_step.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::setpoint_words;
+
+    #[test]
+    fn the_header_says_what_the_setpoint_does_where_the_diagnosis_looked() {
+        let sp = [50.0, 50.0, 50.0, 55.0, 55.0];
+        assert_eq!(
+            setpoint_words(Some(&sp), [0, 3]),
+            " with a constant setpoint"
+        );
+        assert_eq!(
+            setpoint_words(Some(&sp), [0, 5]),
+            " with its setpoint changes"
+        );
+        assert_eq!(setpoint_words(None, [0, 5]), "");
     }
 }
