@@ -110,6 +110,11 @@ pub struct ClosedLoop {
     /// Input (load) disturbance added to the valve's flow before the process, % of flow.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub load: Option<Signal>,
+    /// Feed-forward of the measured load: the controller adds `-gain × load` to its output (1
+    /// cancels a load that enters with the valve's flow, in steady state). Needs `load`. The
+    /// recorded OP is the sum; the PI part is held where it saturates (back-calculation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed_forward: Option<f64>,
     /// Rounding of PV, at the sensor or only in the record.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quantisation: Option<Quantisation>,
@@ -179,6 +184,7 @@ impl ClosedLoop {
             valve_lag: 0.0,
             characteristic: Characteristic::Linear,
             load: None,
+            feed_forward: None,
             quantisation: None,
             historian: Historian::default(),
             cascade: None,
@@ -220,6 +226,15 @@ impl ClosedLoop {
             self.valve_lag,
         )?;
         require(self.warmup >= 0.0, "warm-up", ">= 0 seconds", self.warmup)?;
+        if let Some(g) = self.feed_forward {
+            require(g.is_finite(), "feed-forward gain", "finite", g)?;
+            require(
+                self.load.is_some(),
+                "feed-forward (a load to measure)",
+                "given with a load",
+                g,
+            )?;
+        }
         self.characteristic.validate()?;
         if let Some(q) = &self.quantisation {
             q.validate()?;
@@ -302,10 +317,22 @@ impl ClosedLoop {
             if control {
                 let e = sp[t] - pv;
                 if t > 0 {
-                    op = (op_prev + kc * (e - e_prev) + kc * h / ti * e).clamp(0.0, 100.0);
+                    let pi = op_prev + kc * (e - e_prev) + kc * h / ti * e;
+                    op = match (self.feed_forward, &load) {
+                        (Some(g), Some(l)) => {
+                            let ff = -g * l[t];
+                            let total = (pi + ff).clamp(0.0, 100.0);
+                            // the PI part, held where the sum saturates
+                            op_prev = total - ff;
+                            total
+                        }
+                        _ => pi.clamp(0.0, 100.0),
+                    };
                     stem = self.model.step(&mut valve, op);
                 }
-                op_prev = op;
+                if self.feed_forward.is_none() {
+                    op_prev = op;
+                }
                 e_prev = e;
                 tr.executed(t, op, stem);
             }

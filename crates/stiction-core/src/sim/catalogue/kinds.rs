@@ -41,11 +41,14 @@ pub enum LoopClass {
     /// Healthy valve with a load that changes in steps OP does not explain (a feed rate or an
     /// upstream pressure that jumps): PV kicks at each step while OP answers it.
     LoadSteps,
+    /// Healthy valve whose controller adds a feed-forward of a measured load that jumps in
+    /// steps: OP moves with the load while PV, the load compensated, hardly does.
+    FeedForward,
 }
 
 impl LoopClass {
     /// Every class, in catalogue order.
-    pub const ALL: [LoopClass; 15] = [
+    pub const ALL: [LoopClass; 16] = [
         Self::StenmanValve,
         Self::KanoValve,
         Self::HeValve,
@@ -61,6 +64,7 @@ impl LoopClass {
         Self::SaturatedOp,
         Self::CascadeInner,
         Self::LoadSteps,
+        Self::FeedForward,
     ];
 
     /// The truth a verdict on this class is judged against.
@@ -90,6 +94,7 @@ impl LoopClass {
             Self::SaturatedOp => "saturated_op",
             Self::CascadeInner => "cascade_inner",
             Self::LoadSteps => "load_steps",
+            Self::FeedForward => "feed_forward",
         }
     }
 }

@@ -2,12 +2,12 @@
 //! (sticky valve, healthy valve, backlash only), to calibrate and check `diagnose`.
 //!
 //! Two suites, after the benchmark parts of issues 10 and 14:
-//! - [`Suite::Routine`] (510 loops): routine plant historian windows, 750 samples every 10 s or
+//! - [`Suite::Routine`] (540 loops): routine plant historian windows, 750 samples every 10 s or
 //!   2,000 every 1 s, of flow, pressure, level (integrating) and temperature or analyser loops
 //!   under SIMC (lambda) tuning, excited by setpoint step sequences, slow load drifts and load
-//!   ramps. Half have a sticky valve (Stenman `d`, Kano `S`/`J`, He `fs`/`fd`, bands 0.5 to 5 % of
+//!   ramps. 240 have a sticky valve (Stenman `d`, Kano `S`/`J`, He `fs`/`fd`, bands 0.5 to 5 % of
 //!   span, log-uniform); the others are healthy look-alikes (equal-percentage valve, quantised PV,
-//!   compressed PV, slow process with long delay, aggressive tuning, external oscillation, load steps, plain),
+//!   compressed PV, slow process with long delay, aggressive tuning, external oscillation, load steps, load steps fed forward to OP, plain),
 //!   plus a backlash-only valve (Kano with `J = 0`, see [`crate::sim::backlash`]) reported apart.
 //! - [`Suite::Fast`] (240 loops): fast loops that limit-cycle (flow, pressure, cooling water), PI
 //!   every 1-3 s, samples every 1-5 s, actuator lag, bands 0.5-5 %; look-alikes: an external
@@ -86,6 +86,7 @@ pub fn plan(suite: Suite) -> &'static [(LoopClass, usize)] {
             (AggressiveTuning, 30),
             (ExternalOscillation, 30),
             (LoadSteps, 30),
+            (FeedForward, 30),
         ],
         Suite::Fast => &[
             (StenmanValve, 30),

@@ -192,6 +192,25 @@ fn look_alike(class: LoopClass, cl: &mut ClosedLoop, window: f64, d: &mut Draw) 
                 min_hold * 3.0 / 60.0
             ));
         }
+        LoopClass::FeedForward => {
+            let amplitude = d.uniform(2.0, 8.0);
+            let min_hold = window * d.uniform(0.05, 0.12);
+            cl.load = Some(Signal::RandomSteps {
+                amplitude,
+                min_hold,
+                max_hold: min_hold * d.uniform(1.5, 3.0),
+                offset: 0.0,
+                seed: d.seed(),
+            });
+            let gain = d.uniform(0.7, 1.1);
+            cl.feed_forward = Some(gain);
+            notes.push(format!(
+                "load steps within ±{amplitude:.1} % held {:.0}-{:.0} min, in place of any other load, {:.0} % of them fed forward to OP",
+                min_hold / 60.0,
+                min_hold * 3.0 / 60.0,
+                100.0 * gain
+            ));
+        }
         LoopClass::ExternalOscillation => {
             let lo = (8.0 * cl.ts).max(30.0);
             let period = d.log_uniform(lo, window / 6.0);
