@@ -809,3 +809,31 @@ fn a_cycle_that_saturation_cuts_short_is_judged_by_its_saturation() {
     let d = diagnose(&record(&quiet), &DiagnoseRequest::default()).unwrap();
     assert_eq!(d.verdict, Verdict::InsufficientData);
 }
+
+#[test]
+fn op_steps_the_error_did_not_provoke_cast_no_stiction_vote() {
+    // routine-c-0518 of the plant catalogue (calibration set): a healthy level valve whose
+    // controller feeds a measured load's steps forward to OP; OP jumps while PV, the load
+    // compensated, stays at its setpoint, and the closed-loop fit explained that by a valve that
+    // sticks through the jumps (test ratio 69): it was called `stiction`
+    let d = judge_catalogue("routine-c-0518");
+    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let m = model_family(&d);
+    assert_eq!(m.vote, Vote::Undetermined, "{}", m.note);
+    let e = m.model.as_ref().unwrap();
+    assert!(e.op_moved_elsewhere);
+    let u = e.unprovoked_op_steps.unwrap();
+    assert!(u.steps > 0 && u.withdraws(), "{u:?}");
+    assert!(
+        m.note.contains("control error stays inside its noise"),
+        "{}",
+        m.note
+    );
+    // a sticky valve's OP is its controller's: no unprovoked step
+    for id in ["routine-c-0000", "routine-c-0100", "routine-c-0200"] {
+        let d = judge_catalogue(id);
+        let e = model_family(&d).model.clone().unwrap();
+        assert_eq!(e.unprovoked_op_steps.unwrap().steps, 0, "{id}");
+        assert!(!e.op_moved_elsewhere, "{id}");
+    }
+}

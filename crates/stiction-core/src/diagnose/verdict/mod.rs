@@ -264,7 +264,14 @@ fn without_votes(
     if !leaning.is_empty() {
         return (Verdict::Undetermined, leaning_reason(leaning));
     }
-    if mirrors_controller(families) {
+    if model_flag(families, |m| m.op_moved_elsewhere) {
+        return (
+            Verdict::Undetermined,
+            "the loop moves, but only the closed-loop fit could judge it, and OP steps while the control error stays at rest (an input the record does not hold: a feed-forward, an override, an operator): PV need not follow those steps, so the fit's band is no vote, and no other family votes"
+                .to_string(),
+        );
+    }
+    if model_flag(families, |m| m.fit_mirrors_controller) {
         return (
             Verdict::Undetermined,
             "the loop moves, but only the closed-loop fit could judge it, and it explains PV through the controller's own law (a load OP does not explain moves the loop, not the setpoint): its gain with a band is no vote, and no other family votes"
@@ -289,11 +296,14 @@ fn without_votes(
     (Verdict::InsufficientData, reason)
 }
 
-/// Whether the closed-loop fit's stiction vote was withdrawn because it mirrors the controller.
-fn mirrors_controller(families: &[FamilyEvidence]) -> bool {
-    families.iter().any(|f| {
-        f.family == Family::Model && f.model.as_ref().is_some_and(|m| m.fit_mirrors_controller)
-    })
+/// Whether the closed-loop fit's evidence carries `flag` (why its stiction vote was withdrawn).
+fn model_flag(
+    families: &[FamilyEvidence],
+    flag: impl Fn(&super::evidence::ModelEvidence) -> bool,
+) -> bool {
+    families
+        .iter()
+        .any(|f| f.family == Family::Model && f.model.as_ref().is_some_and(&flag))
 }
 
 /// Why a record whose families measured something but none voted is undetermined: which lean

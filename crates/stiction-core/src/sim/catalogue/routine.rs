@@ -176,38 +176,13 @@ fn look_alike(class: LoopClass, cl: &mut ClosedLoop, window: f64, d: &mut Draw) 
             }
             notes.push(note.to_lowercase());
         }
-        LoopClass::LoadSteps => {
-            let amplitude = d.uniform(2.0, 8.0);
-            let min_hold = window * d.uniform(0.05, 0.12);
-            cl.load = Some(Signal::RandomSteps {
-                amplitude,
-                min_hold,
-                max_hold: min_hold * d.uniform(1.5, 3.0),
-                offset: 0.0,
-                seed: d.seed(),
-            });
-            notes.push(format!(
-                "load steps within ±{amplitude:.1} % held {:.0}-{:.0} min, in place of any other load",
-                min_hold / 60.0,
-                min_hold * 3.0 / 60.0
-            ));
-        }
+        LoopClass::LoadSteps => notes.push(load_steps(cl, window, d)),
         LoopClass::FeedForward => {
-            let amplitude = d.uniform(2.0, 8.0);
-            let min_hold = window * d.uniform(0.05, 0.12);
-            cl.load = Some(Signal::RandomSteps {
-                amplitude,
-                min_hold,
-                max_hold: min_hold * d.uniform(1.5, 3.0),
-                offset: 0.0,
-                seed: d.seed(),
-            });
+            let steps = load_steps(cl, window, d);
             let gain = d.uniform(0.7, 1.1);
             cl.feed_forward = Some(gain);
             notes.push(format!(
-                "load steps within ±{amplitude:.1} % held {:.0}-{:.0} min, in place of any other load, {:.0} % of them fed forward to OP",
-                min_hold / 60.0,
-                min_hold * 3.0 / 60.0,
+                "{steps}, {:.0} % of them fed forward to OP",
                 100.0 * gain
             ));
         }
@@ -219,6 +194,25 @@ fn look_alike(class: LoopClass, cl: &mut ClosedLoop, window: f64, d: &mut Draw) 
         _ => {}
     }
     notes
+}
+
+/// A load that jumps in steps OP does not explain (held 5-12 % of the `window`, seconds, each
+/// hold up to 1.5-3 times the shortest), in place of any other load; returns it in words.
+fn load_steps(cl: &mut ClosedLoop, window: f64, d: &mut Draw) -> String {
+    let amplitude = d.uniform(2.0, 8.0);
+    let min_hold = window * d.uniform(0.05, 0.12);
+    cl.load = Some(Signal::RandomSteps {
+        amplitude,
+        min_hold,
+        max_hold: min_hold * d.uniform(1.5, 3.0),
+        offset: 0.0,
+        seed: d.seed(),
+    });
+    format!(
+        "load steps within ±{amplitude:.1} % held {:.0}-{:.0} min, in place of any other load",
+        min_hold / 60.0,
+        min_hold * 3.0 / 60.0
+    )
 }
 
 /// An external oscillation of `period` seconds as a sine or narrow-band noise, entering as a load

@@ -24,12 +24,14 @@
 
 mod cycle;
 mod levels;
+mod unprovoked;
 
 use cycle::clock_regular;
 pub use cycle::{
     CycleCancelled, CYCLE_CANCELLED_STICTION, FORCED_CROSSINGS, FORCED_GAIN, FORCED_REGULARITY,
 };
 pub use levels::{LevelsEvidence, LEVELS_STICTION, MAX_UNRECORDED};
+pub use unprovoked::{unprovoked, Unprovoked, MAX_UNPROVOKED_SHARE, QUIET_SIGMAS, STEP_SIGMAS};
 
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
 use crate::diagnose::result::Vote;
@@ -143,6 +145,10 @@ pub struct ModelEvidence {
     /// identified from the control error to OP (self-regulating structures only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub loop_gain: Option<f64>,
+    /// OP's steps the control error did not provoke ([`unprovoked`]); `None` when OP's increments
+    /// or PV's noise cannot be measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unprovoked_op_steps: Option<Unprovoked>,
     /// Share of the output's variance that is noise.
     pub noise_share: f64,
     /// Gain of the linear part fitted with the best stiction model (PV units per OP unit; per
@@ -186,6 +192,10 @@ pub struct ModelEvidence {
     /// gain under [`MIN_LOOP_GAIN`], so the fit explains PV through the controller's own law.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub fit_mirrors_controller: bool,
+    /// The stiction vote was withdrawn: OP steps that the control error did not provoke carry
+    /// [`MAX_UNPROVOKED_SHARE`] or more of OP's travel (a feed-forward, an override, an operator).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub op_moved_elsewhere: bool,
 }
 
 /// The statistics of a comparison: shares of the compared output's variance above its noise.
@@ -309,10 +319,10 @@ impl EvidenceFamily for Model {
                 (vote, strength) = (Vote::Stiction, s);
             }
         }
-        // a fit that mirrors the controller says nothing about the valve
-        if let Some(w) = mirrors_controller(ctx, &evidence, vote, &why) {
+        // a fit that mirrors the controller, or OP's steps that the controller did not make,
+        // say nothing about the valve
+        if let Some(w) = withdrawn(ctx, &mut evidence, vote, &why) {
             (vote, strength, why) = (Vote::Undetermined, 0.0, w);
-            evidence.fit_mirrors_controller = true;
         }
         // measured, between the thresholds: the fit gains more than most healthy loops give
         let leans = (evidence.gain_in_a_clock_regular_cycle
@@ -364,6 +374,7 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
         correlation_span: f.correlation_span,
         explained,
         loop_gain: loop_gain(ctx, f),
+        unprovoked_op_steps: unprovoked(ctx.op, ctx.pv, &ctx.error),
         noise_share,
         gain: f.gain,
         time_constant: f.time_constant,
@@ -380,7 +391,20 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
         cycle_cancelled: None,
         gain_in_a_clock_regular_cycle: false,
         fit_mirrors_controller: false,
+        op_moved_elsewhere: false,
     }
+}
+
+/// Why a stiction vote is withdrawn ([`mirrors_controller`], then [`moved_elsewhere`]), with the
+/// evidence's flag set; `None` when it stands.
+fn withdrawn(ctx: &Context, e: &mut ModelEvidence, vote: Vote, why: &str) -> Option<String> {
+    if let Some(w) = mirrors_controller(ctx, e, vote, why) {
+        e.fit_mirrors_controller = true;
+        return Some(w);
+    }
+    let w = moved_elsewhere(e, vote, why)?;
+    e.op_moved_elsewhere = true;
+    Some(w)
 }
 
 /// Why a stiction vote is withdrawn when the fit mirrors the controller ([`MIN_LOOP_GAIN`]), with
@@ -393,6 +417,23 @@ fn mirrors_controller(ctx: &Context, e: &ModelEvidence, vote: Vote, why: &str) -
         "the fitted process and the identified PI make a loop gain of {g:.3}, under {MIN_LOOP_GAIN}: a loop that weak would not \
          hold PV at its setpoint, so the fit explains PV from OP through the controller's own law (what a load OP does not \
          explain leaves in closed loop), not through the valve, and its gain with a band is no vote ({why})"
+    ))
+}
+
+/// Why a stiction vote is withdrawn when OP steps the control error did not provoke carry a share
+/// of OP's travel ([`MAX_UNPROVOKED_SHARE`]), with the vote's own words `why`; `None` when it
+/// stands.
+fn moved_elsewhere(e: &ModelEvidence, vote: Vote, why: &str) -> Option<String> {
+    let u = e
+        .unprovoked_op_steps
+        .filter(|u| vote == Vote::Stiction && u.withdraws())?;
+    Some(format!(
+        "OP steps {} time{} while the control error stays inside its noise ({:.0} % of OP's travel): a controller acting on the error \
+         does not, so OP has an input the record does not hold (a feed-forward of a measured load, an override, an operator), \
+         PV need not follow such steps, and a band that explains why it does not is no vote ({why})",
+        u.steps,
+        if u.steps == 1 { "" } else { "s" },
+        100.0 * u.share
     ))
 }
 
