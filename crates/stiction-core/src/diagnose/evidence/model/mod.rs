@@ -364,7 +364,7 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
         correlation_span: f.correlation_span,
         explained,
         loop_gain: loop_gain(ctx, f),
-        unprovoked_op_steps: unprovoked(ctx.op, ctx.pv, &ctx.error),
+        unprovoked_op_steps: unprovoked(ctx.op, &ctx.error, ctx.pv_noise),
         noise_share,
         gain: f.gain,
         time_constant: f.time_constant,
