@@ -829,6 +829,14 @@ fn op_steps_the_error_did_not_provoke_cast_no_stiction_vote() {
         "{}",
         m.note
     );
+    // with no other vote the verdict says why, and what to do
+    assert_eq!(d.verdict, Verdict::Undetermined, "{:?}", d.reason);
+    assert!(d
+        .reason
+        .as_deref()
+        .unwrap()
+        .contains("OP steps while the control error stays at rest"));
+    assert!(d.next_step.contains("feed-forward"), "{}", d.next_step);
     // a sticky valve's OP is its controller's: no unprovoked step
     for id in ["routine-c-0000", "routine-c-0100", "routine-c-0200"] {
         let d = judge_catalogue(id);

@@ -395,6 +395,11 @@ fn next_step(
              without one, record the valve position (MV) or run a valve travel test to settle it{}",
             if motion.setpoint_steady { STEADY_SETPOINT } else { "" }
         ),
+        Verdict::Undetermined if model_flag(families, |m| m.op_moved_elsewhere) => {
+            "OP moves with an input the record does not hold: if the controller has a feed-forward, a ratio or an override, \
+             judge a window where it holds still, or record the valve position (MV), or run a valve travel test to settle it"
+                .into()
+        }
         Verdict::Undetermined => format!(
             "record the valve position (MV) or run a valve travel test to settle it{}",
             if motion.setpoint_steady { STEADY_SETPOINT } else { "" }
