@@ -60,11 +60,16 @@ fn row(md: &mut String, name: &str, [fine, coarse]: Cells) {
 const COLUMNS: &str = "sticky called stiction, records under 5 s | slower records | not-sticky not called stiction, records under 5 s | slower records |\n|---|---|---|---|---|";
 
 /// The excitations, as the table names them.
-const EXCITATIONS: [(Excitation, &str); 5] = [
+const EXCITATIONS: [(Excitation, &str); 7] = [
     (Excitation::SetpointSteps, "setpoint steps"),
     (Excitation::StepsAndDrift, "setpoint steps and a load drift"),
     (Excitation::LoadDrift, "a load drift alone"),
     (Excitation::LoadRamp, "a load ramp alone"),
+    (
+        Excitation::StepsAndLoadSteps,
+        "setpoint steps and load steps",
+    ),
+    (Excitation::LoadSteps, "load steps alone"),
     (Excitation::Regulation, "regulation (rare small steps)"),
 ];
 

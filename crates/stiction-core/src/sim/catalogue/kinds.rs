@@ -216,6 +216,24 @@ pub enum Excitation {
     StepsAndDrift,
     /// Regulation at a setpoint with rare small steps and a little load drift (fast loops).
     Regulation,
+    /// Load steps in place of the drawn load, at a constant setpoint (the look-alikes with load
+    /// steps, and with them fed forward).
+    LoadSteps,
+    /// Setpoint steps, and load steps in place of the drawn load.
+    StepsAndLoadSteps,
+}
+
+impl Excitation {
+    /// The excitation once load steps replace the drawn load: the setpoint's part stays.
+    pub fn with_load_steps(self) -> Self {
+        match self {
+            Self::SetpointSteps | Self::StepsAndDrift | Self::StepsAndLoadSteps => {
+                Self::StepsAndLoadSteps
+            }
+            Self::LoadDrift | Self::LoadRamp | Self::LoadSteps => Self::LoadSteps,
+            Self::Regulation => Self::Regulation,
+        }
+    }
 }
 
 /// How the controller was tuned.

@@ -155,6 +155,8 @@ fn excitation_words(e: Excitation, cl: &ClosedLoop) -> String {
         Excitation::LoadRamp => format!("{sp}, load ramp"),
         Excitation::StepsAndDrift => format!("{sp} and a slow load drift"),
         Excitation::Regulation => format!("regulation: {sp}, slight load drift"),
+        // the class's own words name the load steps
+        Excitation::LoadSteps | Excitation::StepsAndLoadSteps => sp,
     }
 }
 

@@ -300,8 +300,11 @@ pub fn build(class: LoopClass, d: &mut Draw) -> Built {
     };
     let (pi, tuning) = tune(class, &lin, window, d);
     cl.pi = pi;
-    let excitation = excite(&mut cl, window, d);
+    let mut excitation = excite(&mut cl, window, d);
     let notes = look_alike(class, &mut cl, window, d);
+    if matches!(class, LoopClass::LoadSteps | LoopClass::FeedForward) {
+        excitation = excitation.with_load_steps();
+    }
     Built {
         setup: cl,
         kind,
