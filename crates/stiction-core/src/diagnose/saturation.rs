@@ -15,7 +15,7 @@
 //! (level loops tuned so hard that the noise drives OP to its limits) show no regular cycle and
 //! stay `insufficient_data`; no sticky loop's record was cut short so, and no other verdict moved.
 
-use super::evidence::limit_cycle::{LIMIT_CYCLES, SATURATION_STRENGTH};
+use super::evidence::limit_cycle::{share_of_cycles, LIMIT_CYCLES, SATURATION_STRENGTH};
 use super::evidence::{Family, FamilyEvidence};
 use super::request::DiagnoseRequest;
 use super::result::{Oscillation, Vote};
@@ -69,13 +69,9 @@ pub(super) fn bounded(
 /// a limit and leaves it: a sample at a limit and one off it (an OP held at a limit throughout
 /// bounds no cycle: the controller did not act).
 fn cycles_at_limit(saturated: &[bool], samples: f64) -> f64 {
-    let w = samples.round().max(2.0) as usize;
-    let cycles: Vec<&[bool]> = saturated.chunks(w).filter(|c| c.len() * 2 >= w).collect();
-    let hit = cycles
-        .iter()
-        .filter(|c| c.iter().any(|&s| s) && c.iter().any(|&s| !s))
-        .count();
-    hit as f64 / cycles.len().max(1) as f64
+    share_of_cycles(saturated, samples, |c| {
+        c.iter().any(|&s| s) && c.iter().any(|&s| !s)
+    })
 }
 
 #[cfg(test)]

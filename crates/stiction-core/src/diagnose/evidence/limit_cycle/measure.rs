@@ -162,14 +162,19 @@ fn at_limit(op: &[f64], period: f64, [lo, hi]: [f64; 2]) -> f64 {
     if op.iter().any(|v| *v < lo || *v > hi) {
         return 0.0;
     }
-    let w = period.round().max(2.0) as usize;
     let near = LIMIT_NEAR * (hi - lo);
-    let chunks: Vec<&[f64]> = op.chunks(w).filter(|c| c.len() * 2 >= w).collect();
-    let hit = chunks
-        .iter()
-        .filter(|c| c.iter().any(|v| *v <= lo + near || *v >= hi - near))
-        .count();
-    hit as f64 / chunks.len().max(1) as f64
+    share_of_cycles(op, period, |c| {
+        c.iter().any(|v| *v <= lo + near || *v >= hi - near)
+    })
+}
+
+/// The share of the cycles of `x` (consecutive windows of `samples`, rounded, at least 2; a tail
+/// under half a window is no cycle) for which `hit` holds.
+pub(crate) fn share_of_cycles<T>(x: &[T], samples: f64, hit: impl Fn(&[T]) -> bool) -> f64 {
+    let w = samples.round().max(2.0) as usize;
+    let cycles: Vec<&[T]> = x.chunks(w).filter(|c| c.len() * 2 >= w).collect();
+    let n = cycles.iter().filter(|c| hit(c)).count();
+    n as f64 / cycles.len().max(1) as f64
 }
 
 /// The valve describing function nearest `needed`, its band for the observed OP amplitude, and the

@@ -68,11 +68,10 @@ pub fn unprovoked(op: &[f64], error: &[f64], pv_noise: f64) -> Option<Unprovoked
     // a controller slower than the record holds OP between its moves: those are not its noise
     let moving: Vec<f64> = d_op.iter().copied().filter(|d| *d != 0.0).collect();
     let op_sd = robust_sd(moving);
-    let e_sd = pv_noise;
-    if !(op_sd > 0.0 && e_sd > 0.0) {
+    if !(op_sd > 0.0 && pv_noise > 0.0) {
         return None;
     }
-    let quiet = |k: usize| error[k].abs() < QUIET_SIGMAS * e_sd;
+    let quiet = |k: usize| error[k].abs() < QUIET_SIGMAS * pv_noise;
     let travel: f64 = d_op.iter().map(|d| d.abs()).sum();
     let (mut steps, mut unprovoked) = (0, 0.0);
     // the sample after OP's previous move: a controller slower than the record acts on the
