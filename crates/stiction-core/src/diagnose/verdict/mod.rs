@@ -151,21 +151,24 @@ impl Motion {
     /// From the oscillation of the analysed stretch, sampled every `ts` seconds, and its
     /// setpoint when recorded.
     pub fn of(osc: &super::Oscillation, ts: f64, sp: Option<&[f64]>) -> Self {
-        let r = &osc.regularity;
-        let unresolved_cycle = r
-            .period
-            .map(|p| (p, p / ts))
-            .filter(|&(_, samples)| samples < UNRESOLVED_SAMPLES)
-            .filter(|_| {
-                r.regularity >= UNRESOLVED_REGULARITY
-                    && r.regularity < crate::detect::REGULARITY_CAP
-            });
         Self {
             oscillating: osc.oscillating,
-            unresolved_cycle,
+            unresolved_cycle: unresolved_cycle(osc, ts),
             setpoint_steady: sp.is_some_and(|sp| sp.windows(2).all(|w| w[1] == w[0])),
         }
     }
+}
+
+/// A regular cycle of fewer than [`UNRESOLVED_SAMPLES`] samples a period in `osc` (sampled every
+/// `ts` seconds): its period, s, and samples per period.
+pub(crate) fn unresolved_cycle(osc: &super::Oscillation, ts: f64) -> Option<(f64, f64)> {
+    let r = &osc.regularity;
+    r.period
+        .map(|p| (p, p / ts))
+        .filter(|&(_, samples)| samples < UNRESOLVED_SAMPLES)
+        .filter(|_| {
+            r.regularity >= UNRESOLVED_REGULARITY && r.regularity < crate::detect::REGULARITY_CAP
+        })
 }
 
 /// Decide from the families' votes and what the oscillation shows (`motion`).
