@@ -90,17 +90,54 @@ pub fn svg_string(chart: &Chart, size: (u32, u32)) -> Result<String> {
     Ok(out)
 }
 
+/// A few samples this far outside the rest (as multiples of the range of the middle
+/// [`KEPT_SHARE`] of the values) would squash the rest into a line: the axis keeps to that
+/// middle range and the outliers are drawn at its edge.
+const OUTLIER_FACTOR: f64 = 20.0;
+/// The share of the values whose range the axis keeps when outliers would squash it.
+const KEPT_SHARE: f64 = 0.998;
+
+/// The y range of the values `ys`: their whole range, or the middle [`KEPT_SHARE`] of them when
+/// a few lie [`OUTLIER_FACTOR`] times that range away (a glitch of 1e308 in a PV).
+fn y_span(ys: &mut [f64]) -> (f64, f64) {
+    if ys.is_empty() {
+        return (f64::INFINITY, f64::NEG_INFINITY);
+    }
+    ys.sort_by(f64::total_cmp);
+    let n = ys.len();
+    let whole = (ys[0], ys[n - 1]);
+    let share = |kept: f64| {
+        let cut = ((1.0 - kept) / 2.0 * n as f64).floor() as usize;
+        (ys[cut], ys[n - 1 - cut])
+    };
+    let width = |(lo, hi): (f64, f64)| hi - lo;
+    let middle = share(KEPT_SHARE);
+    if width(whole).is_finite()
+        && width(whole) <= OUTLIER_FACTOR * width(middle).max(f64::MIN_POSITIVE)
+    {
+        whole
+    } else if width(middle).is_finite() {
+        middle
+    } else {
+        // more than a few samples out of all bounds: the middle half, else a unit range
+        Some(share(0.5))
+            .filter(|&r| width(r).is_finite())
+            .unwrap_or((0.0, 1.0))
+    }
+}
+
 fn bounds(chart: &Chart) -> ((f64, f64), (f64, f64)) {
     let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut yr = xr;
+    let mut ys = Vec::new();
     for s in &chart.series {
         for (&x, &y) in s.x.iter().zip(s.y) {
             if x.is_finite() && y.is_finite() {
                 xr = (xr.0.min(x), xr.1.max(x));
-                yr = (yr.0.min(y), yr.1.max(y));
+                ys.push(y);
             }
         }
     }
+    let mut yr = y_span(&mut ys);
     for b in &chart.bands {
         yr = (yr.0.min(b.lo), yr.1.max(b.hi));
     }
@@ -255,7 +292,15 @@ pub fn draw<DB: DrawingBackend>(
         } else {
             col.stroke_width(width)
         };
-        let pts: Vec<(f64, f64)> = s.x.iter().copied().zip(s.y.iter().copied()).collect();
+        // outliers the axis leaves out are drawn at its edge
+        let pts: Vec<(f64, f64)> =
+            s.x.iter()
+                .copied()
+                .zip(
+                    s.y.iter()
+                        .map(|&y| if y.is_nan() { y } else { y.clamp(y0, y1) }),
+                )
+                .collect();
         match s.kind {
             Kind::Line => chart.draw_series(LineSeries::new(pts, style))?,
             Kind::Step => {
@@ -272,4 +317,58 @@ pub fn draw<DB: DrawingBackend>(
     }
     root.present()?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chart_of<'a>(x: &'a [f64], y: &'a [f64]) -> Chart<'a> {
+        Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            series: vec![Series {
+                label: "pv".into(),
+                x,
+                y,
+                kind: Kind::Line,
+                color: 0,
+                thin: false,
+            }],
+            bands: Vec::new(),
+            y_range: None,
+        }
+    }
+
+    #[test]
+    fn a_glitch_far_outside_the_data_does_not_stretch_the_axis() {
+        let x: Vec<f64> = (0..1000).map(f64::from).collect();
+        let mut y: Vec<f64> = x.iter().map(|t| 50.0 + (t / 20.0).sin()).collect();
+        y[10] = 1e308;
+        y[11] = -1e308;
+        let (_, (lo, hi)) = bounds(&chart_of(&x, &y));
+        assert!(lo > 48.0 && hi < 52.0, "{lo} {hi}");
+        // and the chart is drawn (plotters' ticks never end on an infinite range)
+        let svg = svg_string(&chart_of(&x, &y), (400, 300)).unwrap();
+        assert!(svg.contains("<svg"));
+    }
+
+    #[test]
+    fn a_real_excursion_keeps_the_whole_range() {
+        let x: Vec<f64> = (0..1000).map(f64::from).collect();
+        // a step that holds for a tenth of the record is the process, not a glitch
+        let y: Vec<f64> = x
+            .iter()
+            .map(|&t| {
+                if t > 900.0 {
+                    80.0
+                } else {
+                    50.0 + (t / 20.0).sin()
+                }
+            })
+            .collect();
+        let (_, (lo, hi)) = bounds(&chart_of(&x, &y));
+        assert!(lo < 49.0 && hi > 80.0, "{lo} {hi}");
+    }
 }
