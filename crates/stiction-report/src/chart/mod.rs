@@ -241,7 +241,18 @@ pub fn draw<DB: DrawingBackend>(
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     root.fill(&WHITE)?;
     let ((x0, x1), (y0, y1)) = bounds(c);
-    let root_titled = root.titled(&c.title, ("sans-serif", 24))?;
+    // (a range the caller fixed is a zoom it chose: drawn as plotters draws it)
+    let clipped = c.y_range.is_none()
+        && c.series
+            .iter()
+            .flat_map(|s| s.y.iter())
+            .any(|&y| y.is_finite() && !(y0..=y1).contains(&y));
+    let title = if clipped {
+        format!("{} (outliers at the edge)", c.title)
+    } else {
+        c.title.clone()
+    };
+    let root_titled = root.titled(&title, ("sans-serif", 24))?;
     let entries = legend_entries(c);
     // the legend starts where the plotting area does (margin + y label area)
     let places = legend_places(&root_titled, &entries, 16 + 70);
@@ -298,7 +309,7 @@ pub fn draw<DB: DrawingBackend>(
                 .copied()
                 .zip(
                     s.y.iter()
-                        .map(|&y| if y.is_nan() { y } else { y.clamp(y0, y1) }),
+                        .map(|&y| if clipped { y.clamp(y0, y1) } else { y }),
                 )
                 .collect();
         match s.kind {
@@ -349,9 +360,9 @@ mod tests {
         y[11] = -1e308;
         let (_, (lo, hi)) = bounds(&chart_of(&x, &y));
         assert!(lo > 48.0 && hi < 52.0, "{lo} {hi}");
-        // and the chart is drawn (plotters' ticks never end on an infinite range)
+        // and the chart is drawn (plotters' ticks never end on an infinite range), saying so
         let svg = svg_string(&chart_of(&x, &y), (400, 300)).unwrap();
-        assert!(svg.contains("<svg"));
+        assert!(svg.contains("(outliers at the edge)"), "{svg}");
     }
 
     #[test]
@@ -370,5 +381,7 @@ mod tests {
             .collect();
         let (_, (lo, hi)) = bounds(&chart_of(&x, &y));
         assert!(lo < 49.0 && hi > 80.0, "{lo} {hi}");
+        let svg = svg_string(&chart_of(&x, &y), (400, 300)).unwrap();
+        assert!(!svg.contains("outliers"));
     }
 }
