@@ -271,13 +271,15 @@ impl EvidenceFamily for Model {
         let test = LevelsTest::of(ctx);
         let mut evidence = model_evidence(ctx, f, &levels);
         evidence.levels = test.evidence().cloned();
+        let pct = |v: f64| ctx.req.percent_of_span(v);
         let fits = format!(
-            "R² {:.3} without stiction, {:.3} with (Stenman d = {:.2} % of span; Kano S = {:.2}, J = {:.2})",
+            "R² {:.3} without stiction, {:.3} with Stenman's band (d = {:.2} % of span), {:.3} with a slip jump (Kano S = {:.2}, J = {:.2} % of span)",
             f.linear.r2,
-            f.stenman.r2.max(f.slip_jump.r2),
-            ctx.req.percent_of_span(d),
-            evidence.kano_s,
-            evidence.kano_j
+            f.stenman.r2,
+            pct(d),
+            f.slip_jump.r2,
+            pct(evidence.kano_s),
+            pct(evidence.kano_j)
         );
         let (mut vote, mut strength, mut why) = vote(ctx, f, &levels);
         if vote == Vote::Undetermined
