@@ -246,7 +246,7 @@ pub fn draw<DB: DrawingBackend>(
         && c.series
             .iter()
             .flat_map(|s| s.y.iter())
-            .any(|&y| y.is_finite() && !(y0..=y1).contains(&y));
+            .any(|&y| !y.is_nan() && !(y0..=y1).contains(&y));
     let title = if clipped {
         format!("{} (outliers at the edge)", c.title)
     } else {
@@ -358,6 +358,7 @@ mod tests {
         let mut y: Vec<f64> = x.iter().map(|t| 50.0 + (t / 20.0).sin()).collect();
         y[10] = 1e308;
         y[11] = -1e308;
+        y[12] = f64::INFINITY;
         let (_, (lo, hi)) = bounds(&chart_of(&x, &y));
         assert!(lo > 48.0 && hi < 52.0, "{lo} {hi}");
         // and the chart is drawn (plotters' ticks never end on an infinite range), saying so
