@@ -101,9 +101,9 @@ pub const MIN_INDEPENDENT: f64 = 8.0;
 /// noise is PV's fast changes, but no more than the best fit leaves: on the plant benchmark's
 /// calibration set, 27 of the 540 routine windows whose fits explain 5 to 96 % of PV's changes
 /// were "barely varying above their noise" before (a loop's own fast moves, recorded every
-/// 10 s, pass for noise); 8 healthy ones among them were left `insufficient_data` or
+/// 10 s, pass for noise); 7 not-sticky ones among them were left `insufficient_data` or
 /// `undetermined` and are now `no_stiction`; of the sticky ones, one is now `stiction`, one
-/// `no_stiction`.
+/// `no_stiction`; of the backlash valves, one `stiction`, two `no_stiction`.
 pub const MIN_SIGNAL_SHARE: f64 = 0.05;
 
 /// How the thresholds were set, reported with every result.
