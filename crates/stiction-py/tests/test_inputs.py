@@ -35,6 +35,19 @@ def test_datetime_index_gives_the_sampling_time(loop):
     assert any("not in time order" in n for n in d2.notes)
 
 
+def test_multiindex_columns_are_named_by_tuples(loop, tmp_path):
+    # a frame pivoted by tag and signal has MultiIndex columns: a tuple names one
+    df = loop.copy()
+    df.columns = pd.MultiIndex.from_tuples([("FIC101", c) for c in df.columns])
+    d = stiction.diagnose(df, op=("FIC101", "op"), pv=("FIC101", "pv"), sp=("FIC101", "sp"), time=("FIC101", "t"), quantify=False)
+    a = stiction.diagnose(loop, sp="sp", quantify=False)
+    assert (d.verdict, d.ts, list(d.analysed)) == (a.verdict, a.ts, list(a.analysed))
+    with pytest.raises(stiction.StictionError, match="no column"):
+        stiction.diagnose(df, op=("FIC102", "op"), pv=("FIC101", "pv"))
+    page = stiction.report(df, op=("FIC101", "op"), pv=("FIC101", "pv"), path=tmp_path / "p.html", quantify=False)
+    assert "FIC101 / op" in page.read_text()
+
+
 def test_gaps_and_modes(loop):
     df = loop.copy()
     df["op"] = df["op"].astype(object)

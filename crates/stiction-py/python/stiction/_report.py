@@ -47,13 +47,15 @@ def _names(data: Any, op: Any, pv: Any, sp: Any, mode: Any, time: Any) -> Option
     signals are columns of a DataFrame."""
     if not isinstance(data, pd.DataFrame):
         return None
-    names = {"op": op, "pv": pv}
+    # a MultiIndex column's tuple in words: FIC101 / op
+    label = lambda v: v if isinstance(v, str) else " / ".join(map(str, v))
+    names = {"op": label(op), "pv": label(pv)}
     if sp is not None:
-        names["sp"] = sp
+        names["sp"] = label(sp)
     if mode is not None:
-        names["mode"] = mode
-    if isinstance(time, str):
-        names["time"] = time
+        names["mode"] = label(mode)
+    if isinstance(time, (str, tuple)):
+        names["time"] = label(time)
     elif time is None and isinstance(data.index, pd.DatetimeIndex):
         names["time"] = "index"
     return names

@@ -136,8 +136,11 @@ def loop_columns(
                 f"data must be a pandas DataFrame (or None with arrays as op= and pv=); got {type(data).__name__}"
             )
         for arg, v in (("op", op), ("pv", pv), ("sp", sp), ("mode", mode), ("mv", mv)):
-            if v is not None and not isinstance(v, str):
-                raise StictionError(f"{arg}= names a column of data; got {type(v).__name__}")
+            # a name, or a tuple: a column of a MultiIndex (a frame pivoted by tag and signal)
+            if v is not None and not isinstance(v, (str, tuple)):
+                raise StictionError(
+                    f"{arg}= names a column of data (a name, or a tuple for MultiIndex columns); got {type(v).__name__}"
+                )
         out: Dict[str, Optional[np.ndarray]] = {
             "op": numbers(require(data, op, "op", "controller output op"), op, "controller output op"),
             "pv": numbers(require(data, pv, "pv", "process variable pv"), pv, "process variable pv"),
@@ -146,8 +149,9 @@ def loop_columns(
             "auto": None if mode is None else modes(require(data, mode, "mode", "controller mode"), mode),
         }
         name = "time"
-        if isinstance(time, str):
-            out["time"], name = seconds(require(data, time, "time", "time"), time), time
+        if isinstance(time, (str, tuple)):
+            name = time if isinstance(time, str) else " / ".join(map(str, time))
+            out["time"] = seconds(require(data, time, "time", "time"), name)
         elif time is not None:
             out["time"] = seconds(time, "time")
         elif isinstance(data.index, pd.DatetimeIndex):
