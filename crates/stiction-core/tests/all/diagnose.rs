@@ -718,16 +718,24 @@ fn a_hidden_valve_ratio_under_the_threshold_is_drawn_once() {
     assert_eq!(h.draws, vec![h.ratio], "{h:?}");
 }
 
+/// The catalogue loop `id` judged, asserted not `stiction` and its closed-loop fit's vote
+/// withdrawn (`undetermined`).
+fn judged_with_the_fit_withdrawn(id: &str) -> stiction_core::diagnose::Diagnosis {
+    let d = judge_catalogue(id);
+    assert_ne!(d.verdict, Verdict::Stiction, "{id}: {:?}", d.evidence);
+    let m = model_family(&d);
+    assert_eq!(m.vote, Vote::Undetermined, "{id}: {}", m.note);
+    d
+}
+
 #[test]
 fn a_fit_that_mirrors_the_controller_casts_no_stiction_vote() {
     // routine-c-0490 of the plant catalogue (calibration set): a healthy pressure valve whose
     // load steps OP does not explain; the linear fit reads PV from OP through the controller's own
     // law (a process gain near zero), a band gained on it (test ratio 360) and the loop was called
     // sticky before the loop gain was checked
-    let d = judge_catalogue("routine-c-0490");
-    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let d = judged_with_the_fit_withdrawn("routine-c-0490");
     let m = model_family(&d);
-    assert_eq!(m.vote, Vote::Undetermined, "{}", m.note);
     let g = m.model.as_ref().unwrap().loop_gain.unwrap();
     assert!(
         g < stiction_core::diagnose::evidence::model::MIN_LOOP_GAIN,
@@ -833,10 +841,8 @@ fn op_steps_the_error_did_not_provoke_cast_no_stiction_vote() {
     // controller feeds a measured load's steps forward to OP; OP jumps while PV, the load
     // compensated, stays at its setpoint, and the closed-loop fit explained that by a valve that
     // sticks through the jumps (test ratio 69): it was called `stiction`
-    let d = judge_catalogue("routine-c-0518");
-    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let d = judged_with_the_fit_withdrawn("routine-c-0518");
     let m = model_family(&d);
-    assert_eq!(m.vote, Vote::Undetermined, "{}", m.note);
     let e = m.model.as_ref().unwrap();
     assert!(e.op_moved_elsewhere);
     let u = e.unprovoked_op_steps.unwrap();
