@@ -375,6 +375,24 @@ fn pv_changes_the_fit_explains_are_not_taken_for_noise() {
     );
 }
 
+#[test]
+fn a_compressed_pvs_straight_lines_are_not_read_as_a_valves_shape() {
+    // routine-b-0380 of the plant benchmark: a healthy level loop whose historian stores PV with
+    // compression (straight lines between stored points in 99 % of the samples); the shape
+    // indices read the lines' kinks as a valve's and voted stiction against the other families
+    // (the verdict was `undetermined`)
+    let d = judge_catalogue("routine-b-0380");
+    let shape = family_of(&d, Family::Shape);
+    assert!(shape.value.unwrap() >= 0.3, "{shape:?}");
+    assert_eq!(shape.vote, Vote::Undetermined, "{}", shape.note);
+    assert!(
+        shape.note.contains("historian compression"),
+        "{}",
+        shape.note
+    );
+    assert_eq!(d.verdict, Verdict::NoStiction, "{:?}", d.evidence);
+}
+
 /// The catalogue loop `id` judged as the CLI judges it, without and with `thorough`: not
 /// `stiction` without, `stiction` with. Both diagnoses.
 fn stiction_only_when_thorough(
@@ -867,4 +885,25 @@ fn op_steps_the_error_did_not_provoke_cast_no_stiction_vote() {
         assert_eq!(e.unprovoked_op_steps.unwrap().steps, 0, "{id}");
         assert!(!e.op_moved_elsewhere, "{id}");
     }
+}
+
+#[test]
+fn a_compressed_pvs_steps_cast_no_stiction_vote() {
+    // routine-b-0369 of the plant benchmark: a healthy temperature loop recorded every 10 s whose
+    // historian compressed PV (steps and straight lines in all the samples); the closed-loop fit
+    // read the steps as a sticky valve's (test ratio 62) and the loop was called `stiction`
+    let d = judged_with_the_fit_withdrawn("routine-b-0369");
+    let m = model_family(&d);
+    assert!(m.model.as_ref().unwrap().pv_compressed);
+    assert!(m.note.contains("historian compression"), "{}", m.note);
+    assert_eq!(d.verdict, Verdict::Undetermined, "{:?}", d.reason);
+    assert!(d.reason.as_deref().unwrap().contains("PV is not recorded"));
+    assert!(
+        d.next_step.contains("without compression"),
+        "{}",
+        d.next_step
+    );
+    // a sticky valve's PV, recorded, keeps its vote
+    let d = judge_catalogue("routine-b-0000");
+    assert!(!model_family(&d).model.as_ref().unwrap().pv_compressed);
 }
