@@ -886,24 +886,3 @@ fn op_steps_the_error_did_not_provoke_cast_no_stiction_vote() {
         assert!(!e.op_moved_elsewhere, "{id}");
     }
 }
-
-#[test]
-fn a_compressed_pvs_steps_cast_no_stiction_vote() {
-    // routine-b-0369 of the plant benchmark: a healthy temperature loop recorded every 10 s whose
-    // historian compressed PV (steps and straight lines in all the samples); the closed-loop fit
-    // read the steps as a sticky valve's (test ratio 62) and the loop was called `stiction`
-    let d = judged_with_the_fit_withdrawn("routine-b-0369");
-    let m = model_family(&d);
-    assert!(m.model.as_ref().unwrap().pv_compressed);
-    assert!(m.note.contains("historian compression"), "{}", m.note);
-    assert_eq!(d.verdict, Verdict::Undetermined, "{:?}", d.reason);
-    assert!(d.reason.as_deref().unwrap().contains("PV is not recorded"));
-    assert!(
-        d.next_step.contains("without compression"),
-        "{}",
-        d.next_step
-    );
-    // a sticky valve's PV, recorded, keeps its vote
-    let d = judge_catalogue("routine-b-0000");
-    assert!(!model_family(&d).model.as_ref().unwrap().pv_compressed);
-}

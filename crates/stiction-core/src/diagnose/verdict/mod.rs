@@ -274,13 +274,6 @@ fn without_votes(
                 .to_string(),
         );
     }
-    if model_flag(families, |m| m.pv_compressed) {
-        return (
-            Verdict::Undetermined,
-            "the loop moves, but only the closed-loop fit could judge it, and PV is not recorded in most of the record (historian compression): its steps and straight lines are the historian's, so the fit's band is no vote, and no other family votes; judge a record stored without compression"
-                .to_string(),
-        );
-    }
     if model_flag(families, |m| m.fit_mirrors_controller) {
         return (
             Verdict::Undetermined,
@@ -408,11 +401,6 @@ fn next_step(
         Verdict::Undetermined if model_flag(families, |m| m.op_moved_elsewhere) => {
             "OP moves with an input the record does not hold: if the controller has a feed-forward, a ratio or an override, \
              judge a window where it holds still, or record the valve position (MV), or run a valve travel test to settle it"
-                .into()
-        }
-        Verdict::Undetermined if model_flag(families, |m| m.pv_compressed) => {
-            "export PV without compression (the historian's raw samples, or its compression deviation set to zero for this tag) \
-             and judge it again, or record the valve position (MV), or run a valve travel test to settle it"
                 .into()
         }
         Verdict::Undetermined => format!(

@@ -197,10 +197,6 @@ pub struct ModelEvidence {
     /// [`MAX_UNPROVOKED_SHARE`] or more of OP's travel (a feed-forward, an override, an operator).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub op_moved_elsewhere: bool,
-    /// The stiction vote was withdrawn: PV looks not recorded (historian compression) in more of
-    /// the record than the quality gate allows.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub pv_compressed: bool,
 }
 
 /// The statistics of a comparison: shares of the compared output's variance above its noise.
@@ -249,9 +245,8 @@ impl EvidenceFamily for Model {
              (between the 95th and 97.5th percentiles of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more: then the same test on \
              changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}) or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
              of the PV's variation above its noise; no stiction vote on a loop that does not limit-cycle when the fitted process and the identified PI \
-             make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller), nor where PV is compressed in over {:.0} % of the samples",
-            100.0 * MIN_EXPLAINED,
-            100.0 * ctx.req.limits.repeated_share
+             make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller)",
+            100.0 * MIN_EXPLAINED
         );
         let threshold = if ctx.req.thorough {
             format!(
@@ -404,7 +399,6 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
         gain_in_a_clock_regular_cycle: false,
         fit_mirrors_controller: false,
         op_moved_elsewhere: false,
-        pv_compressed: false,
     }
 }
 

@@ -1,14 +1,7 @@
 //! When the closed-loop fit's stiction vote says nothing about the valve, and is withdrawn: a
-//! fit that mirrors the controller ([`MIN_LOOP_GAIN`]), OP steps the controller did not make
-//! ([`super::MAX_UNPROVOKED_SHARE`]), or a PV the historian compressed. Each sets its flag in the
-//! evidence, and the verdict of a record left with no vote says which.
-//!
-//! A compressed PV (repeats, or exactly straight lines between stored points, in more of the
-//! record than the quality gate allows) holds none of the measurement noise the test weighs a
-//! band's gain against, and its steps and ramps are what a sticky valve draws: on the plant
-//! benchmark's catalogue the fit voted stiction on one healthy loop with a compressed PV in each
-//! set (routine-c-0375, routine-b-0369), and no sticky loop's PV is compressed; withdrawing the
-//! vote there moved those two and nothing else.
+//! fit that mirrors the controller ([`MIN_LOOP_GAIN`]), or OP steps the controller did not make
+//! ([`super::MAX_UNPROVOKED_SHARE`]). Each sets its flag in the evidence, and the verdict of a
+//! record left with no vote says which.
 
 use super::{limit_cycles, ModelEvidence};
 use crate::diagnose::evidence::Context;
@@ -29,8 +22,8 @@ use crate::quantify::FitComparison;
 /// sticky fast loops would lose their verdict).
 pub const MIN_LOOP_GAIN: f64 = 0.1;
 
-/// Why a stiction vote is withdrawn ([`mirrors_controller`], a compressed PV, then
-/// [`moved_elsewhere`]), with the evidence's flag set; `None` when it stands.
+/// Why a stiction vote is withdrawn ([`mirrors_controller`], then [`moved_elsewhere`]), with the
+/// evidence's flag set; `None` when it stands.
 pub(super) fn withdrawn(
     ctx: &Context,
     e: &mut ModelEvidence,
@@ -40,14 +33,6 @@ pub(super) fn withdrawn(
     if let Some(w) = mirrors_controller(ctx, e, vote, why) {
         e.fit_mirrors_controller = true;
         return Some(w);
-    }
-    if vote == Vote::Stiction && ctx.compressed(0, ctx.op.len()) {
-        e.pv_compressed = true;
-        return Some(format!(
-            "PV repeats itself or runs in exactly straight lines in {:.0} % of the samples (historian compression): a PV not \
-             recorded there carries none of its noise and steps as a sticky valve's does, so the fit's gain with a band is no vote ({why})",
-            100.0 * ctx.unrecorded_share(0, ctx.op.len())
-        ));
     }
     let w = moved_elsewhere(e, vote, why)?;
     e.op_moved_elsewhere = true;
