@@ -75,10 +75,17 @@ fn headline(file: &str, d: &Diagnosis) {
 /// The closed-loop fits and the linear loop's balance.
 fn fits(d: &Diagnosis) {
     if let Some(m) = d.families.iter().find_map(|f| f.model.as_ref()) {
-        println!(
-            "  closed-loop fit: R² {:.3} without stiction, {:.3} with (Stenman), {:.3} with a slip jump (Kano)",
-            m.r2_without_stiction, m.r2_stenman, m.r2_slip_jump
-        );
+        if m.band_fits_better() {
+            println!(
+                "  closed-loop fit: R² {:.3} without stiction, {:.3} with (Stenman), {:.3} with a slip jump (Kano)",
+                m.r2_without_stiction, m.r2_stenman, m.r2_slip_jump
+            );
+        } else {
+            println!(
+                "  closed-loop fit: R² {:.3} without stiction; no band found fits better (the search's best: {:.3} with Stenman's band, {:.3} with a slip jump)",
+                m.r2_without_stiction, m.r2_stenman, m.r2_slip_jump
+            );
+        }
     }
     if let Some(l) = d.families.iter().find_map(|f| f.limit_cycle.as_ref()) {
         println!(

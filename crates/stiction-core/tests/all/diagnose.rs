@@ -393,6 +393,25 @@ fn a_compressed_pvs_straight_lines_are_not_read_as_a_valves_shape() {
     assert_eq!(d.verdict, Verdict::NoStiction, "{:?}", d.evidence);
 }
 
+#[test]
+fn where_no_band_found_fits_better_the_note_says_so() {
+    // routine-c-0215 of the plant catalogue (a sticky He valve on a pressure loop at 1 s): the
+    // band search settles at R² 0.78 where the linear loop reaches 0.94; a valve with no band is
+    // a sticky valve too, so the note says no band found fits better instead of reading as if
+    // the stiction model fitted worse
+    let d = judge_catalogue("routine-c-0215");
+    let m = model_family(&d);
+    let e = m.model.as_ref().unwrap();
+    assert!(!e.band_fits_better(), "{}", m.note);
+    assert!(m.note.contains("no band found fits better"), "{}", m.note);
+    assert!(e.improvement <= 0.0 && e.significance <= 0.0, "{e:?}");
+    // a sticky valve whose band fits better keeps the plain words
+    let d = judge_catalogue("routine-b-0000");
+    let m = model_family(&d);
+    assert!(m.model.as_ref().unwrap().band_fits_better());
+    assert!(!m.note.contains("no band found"), "{}", m.note);
+}
+
 /// The catalogue loop `id` judged as the CLI judges it, without and with `thorough`: not
 /// `stiction` without, `stiction` with. Both diagnoses.
 fn stiction_only_when_thorough(

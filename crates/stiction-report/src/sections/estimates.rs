@@ -100,15 +100,26 @@ pub fn estimates(d: &Diagnosis, q: Option<&Quantification>) -> Estimates {
     if let Some(m) = d.families.iter().find_map(|f| f.model.as_ref()) {
         rows.push(kv(
             "Closed-loop fit with and without stiction",
-            format!(
-                "R² {} without stiction, {} with a Stenman band of {} % of span, {} with a slip jump (Kano); \
-                 the stiction model explains {} % more of the PV's variation above its noise",
-                num(m.r2_without_stiction),
-                num(m.r2_stenman),
-                num(m.stenman_d_percent_of_span),
-                num(m.r2_slip_jump),
-                num(100.0 * m.improvement)
-            ),
+            if m.band_fits_better() {
+                format!(
+                    "R² {} without stiction, {} with a Stenman band of {} % of span, {} with a slip jump (Kano); \
+                     the stiction model explains {} % more of the PV's variation above its noise",
+                    num(m.r2_without_stiction),
+                    num(m.r2_stenman),
+                    num(m.stenman_d_percent_of_span),
+                    num(m.r2_slip_jump),
+                    num(100.0 * m.improvement)
+                )
+            } else {
+                format!(
+                    "R² {} without stiction; no band found fits better (the search's best: {} with a Stenman band of {} % of span, \
+                     {} with a slip jump)",
+                    num(m.r2_without_stiction),
+                    num(m.r2_stenman),
+                    num(m.stenman_d_percent_of_span),
+                    num(m.r2_slip_jump)
+                )
+            },
         ));
     }
     if let Some(x0) = q.and_then(|q| q.valve_start) {
