@@ -277,28 +277,10 @@ impl EvidenceFamily for Model {
         };
         let levels = Levels::of(f);
         let improvement = levels.improvement;
-        let d = f.stenman.params[0];
         let test = LevelsTest::of(ctx);
         let mut evidence = model_evidence(ctx, f, &levels);
         evidence.levels = test.evidence().cloned();
-        let pct = |v: f64| ctx.req.percent_of_span(v);
-        let fits = format!(
-            "{}{:.3} with Stenman's band (d = {:.2} % of span), {:.3} with a slip jump (Kano S = {:.2}, J = {:.2} % of span){}",
-            if evidence.band_fits_better() {
-                format!("R² {:.3} without stiction, ", f.linear.r2)
-            } else {
-                format!(
-                    "R² {:.3} without stiction, and no band found fits better (the search's best: ",
-                    f.linear.r2
-                )
-            },
-            f.stenman.r2,
-            pct(d),
-            f.slip_jump.r2,
-            pct(evidence.kano_s),
-            pct(evidence.kano_j),
-            if evidence.band_fits_better() { "" } else { ")" }
-        );
+        let fits = fits_words(ctx, f, &evidence);
         let (mut vote, mut strength, mut why) = vote(ctx, f, &levels);
         if vote == Vote::Undetermined
             && levels.significance <= SIGNIFICANCE_NONE
@@ -374,6 +356,29 @@ impl EvidenceFamily for Model {
             hidden_valve: None,
         }
     }
+}
+
+/// The fits' R² in words, with Stenman's band and Kano's S and J in % of span; where no band
+/// found fits better than the linear loop, it says so ([`ModelEvidence::band_fits_better`]).
+fn fits_words(ctx: &Context, f: &FitComparison, evidence: &ModelEvidence) -> String {
+    let pct = |v: f64| ctx.req.percent_of_span(v);
+    format!(
+        "{}{:.3} with Stenman's band (d = {:.2} % of span), {:.3} with a slip jump (Kano S = {:.2}, J = {:.2} % of span){}",
+        if evidence.band_fits_better() {
+            format!("R² {:.3} without stiction, ", f.linear.r2)
+        } else {
+            format!(
+                "R² {:.3} without stiction, and no band found fits better (the search's best: ",
+                f.linear.r2
+            )
+        },
+        f.stenman.r2,
+        pct(f.stenman.params[0]),
+        f.slip_jump.r2,
+        pct(evidence.kano_s),
+        pct(evidence.kano_j),
+        if evidence.band_fits_better() { "" } else { ")" }
+    )
 }
 
 /// The fits' figures, as the result reports them.
