@@ -35,7 +35,7 @@ pub use crate::quality::Record as LoopRecord;
 
 use crate::checked::Checked;
 use crate::quality::{self, Finding, Gate};
-use crate::quantify::{compare_fits, CompareRequest};
+use crate::quantify::CompareRequest;
 use evidence::Context;
 use oscillation::mean;
 use result::Oscillation as Osc;
@@ -71,6 +71,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         integrating: Some(req.integrating),
         lag: None,
     };
+    let (fits, lag_bound) = evidence::model::compared(r.op, r.pv, &compare);
     let ctx = Context {
         req,
         op: r.op,
@@ -83,7 +84,8 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         op_noise: crate::detect::measurement_noise(r.op),
         pv_quantum: quality::quantum(r.pv),
         unrecorded: quality::unrecorded(r.pv),
-        fits: compare_fits(r.op, r.pv, &compare),
+        fits,
+        lag_bound,
         indices: Default::default(),
     };
     let mut families: Vec<FamilyEvidence> =

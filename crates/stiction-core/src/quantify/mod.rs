@@ -30,7 +30,9 @@ mod search;
 mod start;
 
 use crate::checked::Checked;
-pub use compare::{compare_fits, correlation_span, CompareRequest, FitComparison, ModelFit};
+pub use compare::{
+    compare_fits, correlation_span, max_lag, CompareRequest, FitComparison, ModelFit,
+};
 pub use request::QuantifyRequest;
 pub use result::{
     FitOutput, FitQuality, LinearFamily, LinearModel, Quantification, QuantifyStatus,

@@ -144,6 +144,11 @@ pub(super) const LAG_RESPONSES: f64 = 1.5;
 /// ... at least `MIN_LAG` samples and at most this share of the record.
 const MIN_LAG: usize = 2;
 const MAX_LAG_SHARE: usize = 10;
+
+/// The longest lag of the changes compared on a record of `n` samples ([`MAX_LAG_SHARE`]).
+pub fn max_lag(n: usize) -> usize {
+    (n / MAX_LAG_SHARE).max(MIN_LAG)
+}
 /// An integrating process's changes are compared over at least this share of the record.
 pub(super) const INTEGRATING_LAG_SHARE: usize = 25;
 

@@ -3,9 +3,7 @@
 //! search, whose delays stop short of the lag.
 
 use super::lag::{detrended, half_correlation, off_the_cycle_of};
-use super::{
-    CompareRequest, CYCLE_REGULARITY, INTEGRATING_LAG_SHARE, LAG_RESPONSES, MAX_LAG_SHARE, MIN_LAG,
-};
+use super::{CompareRequest, CYCLE_REGULARITY, INTEGRATING_LAG_SHARE, LAG_RESPONSES, MIN_LAG};
 use crate::identify::{self, Data, SearchRange, Structure};
 use crate::quantify::problem::difference;
 
@@ -51,7 +49,7 @@ impl Setup {
             // a level's change grows with the lag while its noise does not: a long lag
             lag = lag.max(n / INTEGRATING_LAG_SHARE);
         }
-        let max_lag = (n / MAX_LAG_SHARE).max(MIN_LAG);
+        let max_lag = super::max_lag(n);
         let lag = match req.lag {
             Some(l) => l.clamp(MIN_LAG, max_lag),
             None => off_the_cycle_of(lag.clamp(MIN_LAG, max_lag), &reg, max_lag),

@@ -22,11 +22,14 @@
 //! to 42, and at the same healthy percentile the test finds 37 % of the sticky routine loops
 //! instead of 32 %, and 61 % of the sticky fast loops instead of 48 %.)
 
+mod bound;
 mod cycle;
 mod levels;
 mod unprovoked;
 mod withdraw;
 
+pub(crate) use bound::compared;
+pub use bound::BOUND_LAG_DIVISOR;
 use cycle::clock_regular;
 pub use cycle::{
     CycleCancelled, CYCLE_CANCELLED_STICTION, FORCED_CROSSINGS, FORCED_GAIN, FORCED_REGULARITY,
@@ -197,6 +200,10 @@ pub struct ModelEvidence {
     /// [`MAX_UNPROVOKED_SHARE`] or more of OP's travel (a feed-forward, an override, an operator).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub op_moved_elsewhere: bool,
+    /// The lag's bound (samples), when the lag reached it and the comparison over a third of it
+    /// ([`BOUND_LAG_DIVISOR`]), which `lag` then gives, had the higher test ratio.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lag_bound: Option<usize>,
 }
 
 impl ModelEvidence {
@@ -255,7 +262,8 @@ impl EvidenceFamily for Model {
              (between the 95th and 97.5th percentiles of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more: then the same test on \
              changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}) or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
              of the PV's variation above its noise; no stiction vote on a loop that does not limit-cycle when the fitted process and the identified PI \
-             make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller)",
+             make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller); PV's changes are compared over 1.5 response times, \
+             at most a tenth of the record, and where the lag reaches that bound also over a third of it (the higher ratio kept)",
             100.0 * MIN_EXPLAINED
         );
         let threshold = if ctx.req.thorough {
@@ -378,7 +386,12 @@ fn fits_words(ctx: &Context, f: &FitComparison, evidence: &ModelEvidence) -> Str
         pct(evidence.kano_s),
         pct(evidence.kano_j),
         if evidence.band_fits_better() { "" } else { ")" }
-    )
+    ) + &ctx.lag_bound.map_or(String::new(), |b| {
+        format!(
+            "; PV's changes compared over {} samples, a third of the bound of {b} the lag reached (the stronger of the two comparisons)",
+            f.lag
+        )
+    })
 }
 
 /// The fits' figures, as the result reports them.
@@ -422,6 +435,7 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
         gain_in_a_clock_regular_cycle: false,
         fit_mirrors_controller: false,
         op_moved_elsewhere: false,
+        lag_bound: ctx.lag_bound,
     }
 }
 
