@@ -1,0 +1,98 @@
+//! `thorough`: the levels test and the hidden valve.
+
+use super::*;
+
+#[test]
+fn thorough_finds_a_valve_the_fit_of_changes_misses_and_reports_its_band() {
+    // routine-c-0003 of the catalogue's calibration set: a flow loop recorded every second, its
+    // Stenman valve d = 4.53 %; the fit of PV's changes settles on a small band near OP and no
+    // family decides. The levels test finds the valve and the band reported is its own.
+    let (_, d) = stiction_only_when_thorough("routine-c-0003");
+    let band = d.band.unwrap();
+    assert_eq!(band.source, BandSource::Levels, "{band:?}");
+    assert!((band.band_percent_of_span - 4.53).abs() < 0.5, "{band:?}");
+    assert!(
+        band.others
+            .iter()
+            .any(|(s, _)| *s == BandSource::ClosedLoop),
+        "{band:?}"
+    );
+}
+
+#[test]
+fn thorough_finds_a_valve_that_slips_between_the_samples() {
+    // fast-c-0007 of the catalogue's calibration set: a flow loop recorded every 3 s whose
+    // controller runs every second, its Stenman valve d = 2.06 %, high noise. The valve slips at
+    // instants the record does not hold: the fits with and without a band look alike and the
+    // families call it `no_stiction`. The hidden-valve family (with `thorough`) filters the
+    // valve's position and decides.
+    let (plain, d) = stiction_only_when_thorough("fast-c-0007");
+    assert!(plain
+        .families
+        .iter()
+        .all(|f| f.family != Family::HiddenValve));
+    let hidden = hidden_valve_of(&d);
+    assert_eq!(hidden.vote, Vote::Stiction, "{}", hidden.note);
+    let h = hidden.hidden_valve.as_ref().unwrap();
+    assert!(
+        h.ratio >= 60.0 && (0.5..4.0).contains(&h.band_percent_of_span),
+        "{h:?}"
+    );
+    // a first ratio past the threshold is drawn three times in all; the median decides
+    let mut draws = h.draws.clone();
+    assert_eq!(draws.len(), 3, "{h:?}");
+    draws.sort_by(f64::total_cmp);
+    assert_eq!(h.ratio, draws[1], "{h:?}");
+    assert!(hidden.note.contains("median of 3 draws"), "{}", hidden.note);
+    // its band is reported (the fits read the recorded OP as the valve's input), the others
+    // beside it
+    let band = d.band.unwrap();
+    assert_eq!(band.source, BandSource::HiddenValve, "{band:?}");
+    assert!(
+        (2.06 / 1.5..2.06 * 1.5).contains(&band.band_percent_of_span),
+        "{band:?}"
+    );
+    assert!(!band.others.is_empty(), "{band:?}");
+}
+
+#[test]
+fn thorough_runs_the_hidden_valve_only_where_it_can_judge_and_change_the_verdict() {
+    let thorough = DiagnoseRequest {
+        thorough: true,
+        ..DiagnoseRequest::default()
+    };
+    let hidden = |d: &stiction_core::diagnose::Diagnosis| hidden_valve_of(d).clone();
+    // a healthy valve under noise alone: no oscillation, no judgement
+    let calm = run(0.0, |_| {});
+    let d = diagnose(&record(&calm), &thorough).unwrap();
+    let h = hidden(&d);
+    assert_eq!(h.vote, Vote::Undetermined);
+    assert!(h.note.contains("does not oscillate"), "{}", h.note);
+    assert!(h.hidden_valve.is_none());
+    // a sticky valve the other families already call sticky: not run
+    let sticky = run(2.0, |_| {});
+    let d = diagnose(&record(&sticky), &thorough).unwrap();
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    assert!(hidden(&d).note.contains("not run"), "{}", hidden(&d).note);
+}
+
+#[test]
+fn a_hidden_valve_ratio_under_the_threshold_is_drawn_once() {
+    // fast-b-0135 of the catalogue's benchmark set: a healthy valve under an external
+    // oscillation. The hidden valve judges it, finds no sticky valve worth a vote, and does not
+    // draw the particle filter's noise again
+    let l = stiction_core::sim::catalogue::find("fast-b-0135").unwrap();
+    let req = DiagnoseRequest {
+        ts: l.ts(),
+        integrating: l.integrating,
+        thorough: true,
+        ..DiagnoseRequest::default()
+    };
+    let d = diagnose(&record(&l.data), &req).unwrap();
+    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let hidden = hidden_valve_of(&d);
+    assert_eq!(hidden.vote, Vote::Undetermined, "{}", hidden.note);
+    let h = hidden.hidden_valve.as_ref().unwrap();
+    assert!(h.ratio < 60.0, "{h:?}");
+    assert_eq!(h.draws, vec![h.ratio], "{h:?}");
+}
