@@ -19,13 +19,6 @@ pub struct Shape;
 /// Least weighted share of the counted indices behind a stiction vote.
 const MIN_SUPPORT: f64 = 0.7;
 
-// A stiction vote is withheld where PV is compressed (repeats itself or runs in exactly straight
-// lines) in more of the oscillating stretch than the quality gate allows: the ramps and kinks of a
-// compressed PV are the historian's. On the plant benchmark's catalogue this moved four healthy
-// level loops with compressed PVs from `undetermined` to `no_stiction` (one of the calibration
-// set, three of the benchmark set) and nothing else; the vote against stiction is kept
-// (compression makes a cycle look less sinusoidal, not more).
-
 /// Strength of a vote against stiction from the shape of an oscillation: a near-sinusoidal cycle
 /// is what a linear loop gives, but also a sticky valve whose sticks are shorter than a sample.
 const AGAINST_STRENGTH: f64 = 0.5;
@@ -82,8 +75,12 @@ impl EvidenceFamily for Shape {
         if vote == Vote::Stiction && support < MIN_SUPPORT {
             vote = Vote::Undetermined;
         }
-        // a compressed PV is the historian's straight lines between stored points: the kinks and
-        // ramps the indices read as a valve's are the compression's (a vote against still holds)
+        // a compressed PV (repeats, or exactly straight lines between stored points, in more of
+        // the stretch than the quality gate allows) is the historian's drawing: the kinks and
+        // ramps the indices read as a valve's are the compression's. On the plant benchmark's
+        // catalogue this moved four healthy level loops from `undetermined` to `no_stiction`
+        // and nothing else, nor anything on the ISDB; a vote against stiction still holds
+        // (compression makes a cycle look less sinusoidal, not more)
         let compressed = ctx.unrecorded_share(s, e);
         let drawn = vote == Vote::Stiction && ctx.compressed(s, e);
         if drawn {

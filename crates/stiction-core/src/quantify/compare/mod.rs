@@ -149,6 +149,7 @@ const MAX_LAG_SHARE: usize = 10;
 pub fn max_lag(n: usize) -> usize {
     (n / MAX_LAG_SHARE).max(MIN_LAG)
 }
+
 /// An integrating process's changes are compared over at least this share of the record.
 pub(super) const INTEGRATING_LAG_SHARE: usize = 25;
 

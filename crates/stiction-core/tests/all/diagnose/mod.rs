@@ -37,11 +37,7 @@ fn record(l: &LoopData) -> LoopRecord<'_> {
 
 /// A healthy valve on FOPTD (K, tau, delay) under PI (Kc, Ti), with a sine of amplitude 1 and
 /// period 150 s added to the PV.
-fn disturbed(
-    (k, tau, delay): (f64, f64, f64),
-    (kc, ti): (f64, f64),
-    noise: f64,
-) -> LoopData {
+fn disturbed((k, tau, delay): (f64, f64, f64), (kc, ti): (f64, f64), noise: f64) -> LoopData {
     run(0.0, |cl| {
         cl.process = Process::Foptd { k, tau, delay };
         cl.pi.kc = kc;
