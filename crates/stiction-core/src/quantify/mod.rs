@@ -31,7 +31,8 @@ mod start;
 
 use crate::checked::Checked;
 pub use compare::{
-    compare_fits, correlation_span, max_lag, CompareRequest, FitComparison, ModelFit,
+    compare_fits, correlation_span, max_lag, off_the_pv_cycle, CompareRequest, FitComparison,
+    ModelFit,
 };
 pub use request::QuantifyRequest;
 pub use result::{

@@ -25,6 +25,7 @@ mod fits;
 mod lag;
 mod setup;
 pub use dependence::correlation_span;
+pub use lag::off_the_pv_cycle;
 
 use super::problem::{difference, range};
 use crate::identify::{self, Data, Fit, SearchRange, Structure};

@@ -16,7 +16,7 @@
 //! newly called `stiction` (false alarms 9 -> 10).
 
 use super::Levels;
-use crate::quantify::{compare_fits, max_lag, CompareRequest, FitComparison};
+use crate::quantify::{compare_fits, max_lag, off_the_pv_cycle, CompareRequest, FitComparison};
 
 /// Where the lag reaches its bound, the changes are also compared over the bound divided by this.
 pub const BOUND_LAG_DIVISOR: usize = 3;
@@ -36,8 +36,10 @@ pub(crate) fn compared(
     else {
         return (first, None);
     };
+    // (kept off the PV's regular cycle as the first lag is: over whole periods the cycle
+    // cancels, and that comparison has its own, higher threshold)
     let shorter = CompareRequest {
-        lag: Some(f.lag / BOUND_LAG_DIVISOR),
+        lag: Some(off_the_pv_cycle(f.lag / BOUND_LAG_DIVISOR, pv)),
         ..req.clone()
     };
     match compare_fits(op, pv, &shorter) {
