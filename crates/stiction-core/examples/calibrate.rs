@@ -7,8 +7,8 @@
 //! from the same ranges) is diagnosed as `stiction diagnose` does. For each loop the model
 //! family's test ratio is read: the fit's improvement with stiction over the linear loop, held
 //! against the stiction fit's residual per independent change of the compared record. Its
-//! distribution over the healthy loops sets the threshold (`SIGNIFICANCE_STICTION`, between their
-//! 95th and 97.5th percentiles); its distribution over the sticky loops says how many a threshold
+//! distribution over the healthy loops sets the threshold (`SIGNIFICANCE_STICTION`, at about their
+//! 95th percentile); its distribution over the sticky loops says how many a threshold
 //! there finds.
 //!
 //! The ceiling: the same comparison with the *true* valve position recorded by the simulator in

@@ -10,7 +10,7 @@
 //! stiction fit's own residual per independent change of the record, an F-like ratio, and must
 //! exceed what simulated healthy loops of many kinds give (`cargo run --release -p stiction-core
 //! --example calibrate`: the catalogue's calibration set, other seeds than the benchmark's; the
-//! threshold lies between the 95th and 97.5th percentiles of its healthy routine loops). The plant
+//! threshold lies at about the 95th percentile of its healthy routine loops). The plant
 //! data judged are never the training set.
 //!
 //! An independent change spans the samples of the residual's long-run overlap with the change the
@@ -49,10 +49,14 @@ use serde::{Deserialize, Serialize};
 /// The model family.
 pub struct Model;
 
-/// The test's ratio at and above which the fit votes stiction: between the 95th and 97.5th
-/// percentiles healthy simulated routine loops give (calibration set: 47 and 96; over it and
+/// The test's ratio at and above which the fit votes stiction: set between the 95th and 97.5th
+/// percentiles healthy simulated routine loops gave (calibration set: 47 and 96; over it and
 /// nine more draws, 2,078 not-sticky routine loops, the 95th percentile is 55 and 5.6 % reach
-/// 50. Before the fits' delays stopped short of the lag: 42 and 55, and 51 and 5.2 %).
+/// 50. Before the fits' delays stopped short of the lag: 42 and 55, and 51 and 5.2 %). Since the
+/// look-alikes with load steps and with a fed-forward load joined the calibration set (264
+/// not-sticky routine loops; `docs/calibration.md`, 2026-11-27) the 95th and 97.5th percentiles
+/// are 55 and 129 and 6 % reach 50: those look-alikes' high ratios are a fit that mirrors the
+/// controller or follows OP's unprovoked steps, and such votes are withdrawn (`withdraw.rs`).
 pub const SIGNIFICANCE_STICTION: f64 = 50.0;
 /// The ratio at which a stiction vote is held with full strength.
 pub const SIGNIFICANCE_DECISIVE: f64 = 500.0;
@@ -259,7 +263,7 @@ impl EvidenceFamily for Model {
             "improvement of the fit with stiction over the linear loop, share of the PV's variance above its noise";
         let threshold = format!(
             "stiction when the improvement, held against the stiction fit's residual per independent change, reaches {SIGNIFICANCE_STICTION} \
-             (between the 95th and 97.5th percentiles of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more: then the same test on \
+             (about the 95th percentile of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more: then the same test on \
              changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}) or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
              of the PV's variation above its noise; no stiction vote on a loop that does not limit-cycle when the fitted process and the identified PI \
              make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller); PV's changes are compared over 1.5 response times, \
