@@ -5,8 +5,7 @@
 
 use stiction_core::diagnose::evidence::limit_cycle::StictionBasis;
 use stiction_core::diagnose::{
-    diagnose, BandSource, DiagnoseRequest, Diagnosis, Family, FamilyEvidence, LoopRecord, Verdict,
-    Vote,
+    diagnose, BandSource, DiagnoseRequest, Diagnosis, Family, FamilyEvidence, Verdict, Vote,
 };
 use stiction_core::models::{Model, Stenman};
 use stiction_core::sim::{ClosedLoop, LoopData, Pi, Process, Signal};
@@ -34,25 +33,13 @@ fn fast_loop(d: f64, kc: f64, disturbance: Option<Signal>) -> LoopData {
     cl.run().unwrap()
 }
 
-/// The loop's record as `stiction diagnose loop.csv --sp sp` reads it.
-fn record(l: &LoopData) -> LoopRecord<'_> {
-    LoopRecord {
-        op: &l.op,
-        pv: &l.pv,
-        sp: Some(&l.sp),
-        mv: None,
-        time: Some(&l.t),
-        auto: None,
-    }
-}
-
 fn judge(l: &LoopData) -> Diagnosis {
     let req = DiagnoseRequest {
         ts: 2.0,
         quantify: false,
         ..DiagnoseRequest::default()
     };
-    diagnose(&record(l), &req).unwrap()
+    diagnose(&crate::diagnose::record(l), &req).unwrap()
 }
 
 fn loop_family(d: &Diagnosis) -> &FamilyEvidence {

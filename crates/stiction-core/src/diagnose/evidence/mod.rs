@@ -173,12 +173,6 @@ impl Context<'_> {
         let part = self.unrecorded.get(from..to).unwrap_or(&[]);
         part.iter().filter(|&&u| u).count() as f64 / part.len().max(1) as f64
     }
-
-    /// Whether PV looks not recorded in more of `from..to` than the quality gate allows: what
-    /// the families read there is the historian's straight lines and steps.
-    pub fn compressed(&self, from: usize, to: usize) -> bool {
-        self.unrecorded_share(from, to) > self.req.limits.repeated_share
-    }
 }
 
 /// One family of evidence.

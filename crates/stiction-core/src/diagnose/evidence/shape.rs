@@ -82,7 +82,7 @@ impl EvidenceFamily for Shape {
         // and nothing else, nor anything on the ISDB; a vote against stiction still holds
         // (compression makes a cycle look less sinusoidal, not more)
         let compressed = ctx.unrecorded_share(s, e);
-        let drawn = vote == Vote::Stiction && ctx.compressed(s, e);
+        let drawn = vote == Vote::Stiction && compressed > ctx.req.limits.repeated_share;
         if drawn {
             vote = Vote::Undetermined;
         }

@@ -24,7 +24,8 @@ fn run(d: f64, f: impl FnOnce(&mut ClosedLoop)) -> LoopData {
     cl.run().unwrap()
 }
 
-fn record(l: &LoopData) -> LoopRecord<'_> {
+/// The loop's record as `stiction diagnose loop.csv --sp sp` reads it.
+pub(crate) fn record(l: &LoopData) -> LoopRecord<'_> {
     LoopRecord {
         op: &l.op,
         pv: &l.pv,
