@@ -379,13 +379,29 @@ pub(super) fn one_step_sse(
         .sum()
 }
 
-/// Cholesky solve of the upper-triangular-stored normal equations, with a tiny ridge.
+/// Cholesky solve of the upper-triangular-stored normal equations, with a tiny ridge. Each size
+/// has its own copy (the loops then unroll: the exact walk solves one system per valve
+/// trajectory and structure); every copy does the same operations in the same order.
 pub(super) fn solve(g: &[[f64; MAX_P]; MAX_P], h: &[f64; MAX_P], p: usize) -> Option<[f64; MAX_P]> {
-    let trace: f64 = (0..p).map(|i| g[i][i]).sum();
+    match p {
+        0 => solve_n::<0>(g, h),
+        1 => solve_n::<1>(g, h),
+        2 => solve_n::<2>(g, h),
+        3 => solve_n::<3>(g, h),
+        4 => solve_n::<4>(g, h),
+        5 => solve_n::<5>(g, h),
+        6 => solve_n::<6>(g, h),
+        7 => solve_n::<7>(g, h),
+        _ => solve_n::<MAX_P>(g, h),
+    }
+}
+
+fn solve_n<const P: usize>(g: &[[f64; MAX_P]; MAX_P], h: &[f64; MAX_P]) -> Option<[f64; MAX_P]> {
+    let trace: f64 = (0..P).map(|i| g[i][i]).sum();
     let ridge = 1e-12 * trace.max(f64::MIN_POSITIVE);
     // L L' = G, L stored in the lower triangle of `l`
     let mut l = [[0.0f64; MAX_P]; MAX_P];
-    for i in 0..p {
+    for i in 0..P {
         for j in 0..=i {
             let mut sum = g[j][i] + if i == j { ridge } else { 0.0 };
             for k in 0..j {
@@ -402,7 +418,7 @@ pub(super) fn solve(g: &[[f64; MAX_P]; MAX_P], h: &[f64; MAX_P], p: usize) -> Op
         }
     }
     let mut w = [0.0f64; MAX_P];
-    for i in 0..p {
+    for i in 0..P {
         let mut sum = h[i];
         for k in 0..i {
             sum -= l[i][k] * w[k];
@@ -410,9 +426,9 @@ pub(super) fn solve(g: &[[f64; MAX_P]; MAX_P], h: &[f64; MAX_P], p: usize) -> Op
         w[i] = sum / l[i][i];
     }
     let mut x = [0.0f64; MAX_P];
-    for i in (0..p).rev() {
+    for i in (0..P).rev() {
         let mut sum = w[i];
-        for k in i + 1..p {
+        for k in i + 1..P {
             sum -= l[k][i] * x[k];
         }
         x[i] = sum / l[i][i];
