@@ -16,9 +16,14 @@ pub(super) fn inverse_filter_pair(x: &[f64], z: &[f64], a: &[f64]) -> (Vec<f64>,
     let n = x.len();
     debug_assert_eq!(z.len(), n);
     let (mut xf, mut zf) = (vec![0.0; n], vec![0.0; n]);
-    let na = a.len();
-    // the first samples, before every lag lies inside the record
-    for t in 0..na.min(n) {
+    // orders 1 and 2 run by the definition only until every lag lies inside the record, then
+    // without a test per sample (the same sums in the same order); other orders throughout
+    let by_definition = if matches!(a.len(), 1 | 2) {
+        a.len().min(n)
+    } else {
+        n
+    };
+    for t in 0..by_definition {
         let (mut v, mut w) = (x[t], z[t]);
         for (i, ai) in a.iter().enumerate().take(t) {
             v += ai * xf[t - 1 - i];
@@ -27,7 +32,6 @@ pub(super) fn inverse_filter_pair(x: &[f64], z: &[f64], a: &[f64]) -> (Vec<f64>,
         xf[t] = v;
         zf[t] = w;
     }
-    // then each order's recursion without a test per sample (the same sums in the same order)
     match *a {
         [a0] => {
             for t in 1..n {
@@ -41,17 +45,7 @@ pub(super) fn inverse_filter_pair(x: &[f64], z: &[f64], a: &[f64]) -> (Vec<f64>,
                 zf[t] = z[t] + a0 * zf[t - 1] + a1 * zf[t - 2];
             }
         }
-        _ => {
-            for t in na..n {
-                let (mut v, mut w) = (x[t], z[t]);
-                for (i, ai) in a.iter().enumerate() {
-                    v += ai * xf[t - 1 - i];
-                    w += ai * zf[t - 1 - i];
-                }
-                xf[t] = v;
-                zf[t] = w;
-            }
-        }
+        _ => {}
     }
     (xf, zf)
 }
