@@ -8,6 +8,7 @@ mod batch;
 mod batch_faults;
 mod batch_layout;
 mod cli;
+mod compressed;
 mod diagnose;
 mod exports;
 mod first_hour;

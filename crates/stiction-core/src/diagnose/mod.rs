@@ -90,7 +90,10 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
     };
     let mut families: Vec<FamilyEvidence> =
         evidence::all().iter().map(|f| f.evaluate(&ctx)).collect();
-    let motion = verdict::Motion::of(&ctx.oscillation, req.ts, r.sp);
+    let motion = verdict::Motion::of(&ctx.oscillation, req.ts, r.sp).with_pv_not_recorded(
+        ctx.unrecorded_share(0, r.pv.len()),
+        req.limits.repeated_share,
+    );
     let mut decision = verdict::decide(&families, &motion);
     // the hidden valve costs seconds: only with `thorough`, only where it can change the verdict
     if req.thorough {

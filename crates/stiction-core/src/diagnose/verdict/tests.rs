@@ -78,6 +78,24 @@ fn weak_evidence_against_stiction_says_so_in_the_next_step() {
     let d = decide(&[weak(0.9)], &calm());
     assert_eq!(d.verdict, Verdict::NoStiction);
     assert_eq!(d.next_step, "no action on the valve");
+    // a PV mostly not recorded: compression hides sticks, and the step says so
+    let compressed = calm().with_pv_not_recorded(0.8, 0.5);
+    let d = decide(&[weak(0.9)], &compressed);
+    assert_eq!(d.verdict, Verdict::NoStiction);
+    assert!(
+        d.next_step
+            .starts_with("no action on the valve; but PV is not recorded in 80 %"),
+        "{}",
+        d.next_step
+    );
+    assert!(
+        d.next_step.contains("without compression"),
+        "{}",
+        d.next_step
+    );
+    // at or under the gate's limit it is the plain step
+    let d = decide(&[weak(0.9)], &calm().with_pv_not_recorded(0.5, 0.5));
+    assert_eq!(d.next_step, "no action on the valve");
 }
 
 #[test]

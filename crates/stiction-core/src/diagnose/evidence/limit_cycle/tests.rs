@@ -15,6 +15,7 @@ fn oscillating() -> Motion {
         oscillating: true,
         unresolved_cycle: None,
         setpoint_steady: false,
+        pv_not_recorded: None,
     }
 }
 
