@@ -14,6 +14,7 @@ mod exports;
 mod first_hour;
 mod json_pin;
 mod limit_cycle;
+mod no_setpoint;
 mod reading;
 mod render;
 mod report;

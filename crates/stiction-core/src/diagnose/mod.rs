@@ -20,6 +20,7 @@ pub mod oscillation;
 mod request;
 mod result;
 mod saturation;
+pub mod setpoint;
 mod stretch;
 mod verdict;
 mod windows;
@@ -48,7 +49,12 @@ struct Judged {
     oscillation: Osc,
     decision: verdict::Decision,
     fits: Option<crate::quantify::FitComparison>,
+    /// Without a recorded setpoint, the setpoint steps read off OP and PV ([`setpoint`]).
+    setpoint_steps: usize,
 }
+
+/// The warning on a record without SP begins so.
+const NO_SETPOINT: &str = "no setpoint column";
 
 /// The control error: SP - PV, or without a setpoint the PV's deviation from its mean.
 fn control_error(pv: &[f64], sp: Option<&[f64]>) -> Vec<f64> {
@@ -63,8 +69,11 @@ fn control_error(pv: &[f64], sp: Option<&[f64]>) -> Vec<f64> {
 
 /// Judge one usable stretch (every sample present, automatic).
 fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
-    let error = control_error(r.pv, r.sp);
-    let oscillation = oscillation::of_record(&error, r.sp, req.ts);
+    let pv_noise = crate::detect::measurement_noise(r.pv);
+    let inferred = setpoint::unless_recorded(r, pv_noise);
+    let sp = r.sp.or(inferred.as_ref().map(|i| i.sp.as_slice()));
+    let error = control_error(r.pv, sp);
+    let oscillation = oscillation::of_record(&error, sp, req.ts);
     let compare = CompareRequest {
         ts: req.ts,
         max_delay: req.max_delay,
@@ -80,7 +89,8 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         mv: r.mv,
         error,
         oscillation,
-        pv_noise: crate::detect::measurement_noise(r.pv),
+        pv_noise,
+        setpoint_steps: inferred.as_ref().map_or(0, |i| i.steps.len()),
         op_noise: crate::detect::measurement_noise(r.op),
         pv_quantum: quality::quantum(r.pv),
         unrecorded: quality::unrecorded(r.pv),
@@ -90,7 +100,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
     };
     let mut families: Vec<FamilyEvidence> =
         evidence::all().iter().map(|f| f.evaluate(&ctx)).collect();
-    let motion = verdict::Motion::of(&ctx.oscillation, req.ts, r.sp).with_pv_not_recorded(
+    let motion = verdict::Motion::of(&ctx.oscillation, req.ts, sp).with_pv_not_recorded(
         ctx.unrecorded_share(0, r.pv.len()),
         req.limits.repeated_share,
     );
@@ -111,6 +121,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         oscillation,
         indices,
         fits,
+        setpoint_steps,
         ..
     } = ctx;
     Judged {
@@ -119,6 +130,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         oscillation,
         decision,
         fits,
+        setpoint_steps,
     }
 }
 
@@ -186,10 +198,9 @@ pub fn diagnose_checked(
         ));
     }
     if r.sp.is_none() {
-        warnings.push(
-            "no setpoint column: the control error is taken as the PV's deviation from its mean"
-                .into(),
-        );
+        warnings.push(format!(
+            "{NO_SETPOINT}: the control error is taken as the PV's deviation from its mean"
+        ));
     }
     let windows = req
         .window
@@ -228,6 +239,11 @@ pub fn diagnose_checked(
         return Ok(unjudged(d, reason, next_step, started));
     }
     let j = judge(&sub, req);
+    if j.setpoint_steps > 0 {
+        if let Some(w) = d.warnings.iter_mut().find(|w| w.starts_with(NO_SETPOINT)) {
+            *w = setpoint::words(j.setpoint_steps);
+        }
+    }
     d.verdict = j.decision.verdict;
     d.confidence = j.decision.confidence;
     d.reason = j.decision.reason;

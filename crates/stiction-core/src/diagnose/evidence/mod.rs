@@ -145,8 +145,11 @@ pub struct Context<'a> {
     pub sp: Option<&'a [f64]>,
     /// The recorded valve position (mv) over the analysed stretch, OP units, when recorded.
     pub mv: Option<&'a [f64]>,
-    /// The control error (SP - PV, or the PV's deviation from its mean without SP).
+    /// The control error (SP - PV; without SP, PV's deviation from the setpoint read off the
+    /// record, or from its mean).
     pub error: Vec<f64>,
+    /// Without SP, the setpoint steps read off the record ([`crate::diagnose::setpoint`]).
+    pub setpoint_steps: usize,
     /// The oscillation on the longest constant-setpoint stretch (indices relative to `op`).
     pub oscillation: Oscillation,
     /// Robust noise standard deviations of PV and OP (from first differences).

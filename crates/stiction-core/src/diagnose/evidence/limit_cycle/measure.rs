@@ -41,8 +41,14 @@ pub(super) fn measure(ctx: &Context) -> Result<LoopEvidence, String> {
         return Err("OP or the control error does not move: no controller to identify".into());
     };
     let caveat = ctx.sp.is_none().then(|| {
-        "no setpoint recorded: the error is taken as the PV's deviation from its mean; the inner loop of a cascade, whose setpoint moves with the outer loop, \
-         would weaken this evidence".to_string()
+        format!(
+            "no setpoint recorded: the error is taken as the PV's deviation from {}; the inner loop of a cascade, whose setpoint moves with the outer loop, \
+             would weaken this evidence",
+            match ctx.setpoint_steps {
+                0 => "its mean".to_string(),
+                n => format!("the setpoint read off the record ({})", crate::diagnose::gates::plural(n, "step", "steps")),
+            }
+        )
     });
     if pi.r2 < MIN_PI_R2 {
         return Err(format!(

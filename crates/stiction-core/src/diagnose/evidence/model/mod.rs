@@ -35,7 +35,9 @@ pub use cycle::{
     CycleCancelled, CYCLE_CANCELLED_STICTION, FORCED_CROSSINGS, FORCED_GAIN, FORCED_REGULARITY,
 };
 pub use levels::{LevelsEvidence, LEVELS_STICTION, MAX_UNRECORDED};
-pub use unprovoked::{unprovoked, Unprovoked, MAX_UNPROVOKED_SHARE, QUIET_SIGMAS, STEP_SIGMAS};
+pub use unprovoked::{
+    robust_sd, unprovoked, Unprovoked, MAX_UNPROVOKED_SHARE, QUIET_SIGMAS, STEP_SIGMAS,
+};
 pub use withdraw::MIN_LOOP_GAIN;
 use withdraw::{loop_gain, withdrawn};
 

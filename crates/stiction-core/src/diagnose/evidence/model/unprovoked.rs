@@ -46,7 +46,7 @@ impl Unprovoked {
 }
 
 /// 1.4826 times the median absolute deviation of `x` from its median (0 when empty).
-fn robust_sd(mut x: Vec<f64>) -> f64 {
+pub fn robust_sd(mut x: Vec<f64>) -> f64 {
     if x.is_empty() {
         return 0.0;
     }

@@ -1,0 +1,42 @@
+//! A record exported without its setpoint: where the setpoint stepped, the steps are read off OP
+//! and PV (OP stepped while PV was still, then PV settled at a new level) and the warning says so;
+//! where it held, the error stays PV's deviation from its mean.
+
+use crate::common::{closed_stenman, json, ok};
+
+#[test]
+fn setpoint_steps_are_read_off_a_record_without_sp() {
+    let dir = tempfile::tempdir().unwrap();
+    let steps = dir.path().join("steps.csv");
+    closed_stenman(
+        &steps,
+        "0",
+        &[
+            "--noise",
+            "0.05",
+            "--seed",
+            "3",
+            "--sp",
+            "steps:amplitude=2,hold=300,offset=50,seed=1",
+        ],
+    );
+    // judged without --sp, as an export without the setpoint column is
+    let v = json(&ok(&["diagnose", steps.to_str().unwrap(), "--json"]));
+    assert_ne!(v["verdict"], "stiction", "{v:#}");
+    let warnings = v["warnings"].to_string();
+    assert!(
+        warnings.contains("setpoint steps read off the record"),
+        "{warnings}"
+    );
+    // the same loop at a steady setpoint: nothing to read off
+    let steady = dir.path().join("steady.csv");
+    closed_stenman(
+        &steady,
+        "0",
+        &["--noise", "0.05", "--seed", "3", "--sp", "const:value=50"],
+    );
+    let v = json(&ok(&["diagnose", steady.to_str().unwrap(), "--json"]));
+    let warnings = v["warnings"].to_string();
+    assert!(warnings.contains("deviation from its mean"), "{warnings}");
+    assert!(!warnings.contains("read off"), "{warnings}");
+}
