@@ -150,79 +150,66 @@ mod tests {
     use crate::models::{Model, Stenman};
     use crate::sim::{ClosedLoop, Signal};
 
+    /// A healthy PI loop of 1,200 samples (noise 0.05) whose setpoint steps from 50 by +2 at
+    /// `first` and by -3 at `second` (seconds; `None`: held at 50): OP, PV, SP and PV's noise.
+    fn pi_loop(steps: Option<(f64, f64)>) -> (Vec<f64>, Vec<f64>, Vec<f64>, f64) {
+        let mut sim = ClosedLoop::new(Model::Stenman(Stenman::new(0.0).unwrap()));
+        sim.samples = 1200;
+        sim.noise = 0.05;
+        sim.setpoint = match steps {
+            Some((first, second)) => Signal::Sum {
+                parts: vec![
+                    Signal::Step {
+                        from: 50.0,
+                        to: 52.0,
+                        at: first,
+                    },
+                    Signal::Step {
+                        from: 0.0,
+                        to: -3.0,
+                        at: second,
+                    },
+                ],
+            },
+            None => Signal::Constant { value: 50.0 },
+        };
+        let d = sim.run().unwrap();
+        let noise = crate::detect::measurement_noise(&d.pv);
+        (d.op, d.pv, d.sp, noise)
+    }
+
     /// A PI loop's setpoint steps are found where they were made, and the setpoint read off the
     /// record is within PV's noise of the true one once PV has settled; a record whose setpoint
     /// holds gives none.
     #[test]
     fn a_pis_setpoint_steps_are_read_off_op_and_pv() {
-        let mut sim = ClosedLoop::new(Model::Stenman(Stenman::new(0.0).unwrap()));
-        sim.samples = 1200;
-        sim.noise = 0.05;
-        sim.setpoint = Signal::Sum {
-            parts: vec![
-                Signal::Step {
-                    from: 50.0,
-                    to: 52.0,
-                    at: 300.0,
-                },
-                Signal::Step {
-                    from: 0.0,
-                    to: -3.0,
-                    at: 700.0,
-                },
-            ],
-        };
-        let d = sim.run().unwrap();
-        let noise = crate::detect::measurement_noise(&d.pv);
-        let found = inferred(&d.op, &d.pv, noise).expect("two setpoint steps");
+        let (op, pv, sp, noise) = pi_loop(Some((300.0, 700.0)));
+        let found = inferred(&op, &pv, noise).expect("two setpoint steps");
         assert_eq!(found.steps.len(), 2, "{:?}", found.steps);
         for (&s, t) in found.steps.iter().zip([300, 700]) {
             assert!(s.abs_diff(t) <= 2, "step at {s}, made at {t}");
         }
         for k in [250, 650, 1150] {
             assert!(
-                (found.sp[k] - d.sp[k]).abs() < 4.0 * noise,
+                (found.sp[k] - sp[k]).abs() < 4.0 * noise,
                 "sample {k}: {} against {}",
                 found.sp[k],
-                d.sp[k]
+                sp[k]
             );
         }
-        let mut steady = ClosedLoop::new(Model::Stenman(Stenman::new(0.0).unwrap()));
-        steady.samples = 1200;
-        steady.setpoint = Signal::Constant { value: 50.0 };
-        steady.noise = 0.05;
-        let d = steady.run().unwrap();
-        let noise = crate::detect::measurement_noise(&d.pv);
-        assert_eq!(inferred(&d.op, &d.pv, noise), None);
+        let (op, pv, _, noise) = pi_loop(None);
+        assert_eq!(inferred(&op, &pv, noise), None);
     }
 
     /// A setpoint step too near the record's end for PV to settle after it is not read, and the
     /// setpoint read off holds no gap.
     #[test]
     fn a_step_without_room_to_settle_is_not_read() {
-        let mut sim = ClosedLoop::new(Model::Stenman(Stenman::new(0.0).unwrap()));
-        sim.samples = 1200;
-        sim.noise = 0.05;
-        sim.setpoint = Signal::Sum {
-            parts: vec![
-                Signal::Step {
-                    from: 50.0,
-                    to: 52.0,
-                    at: 500.0,
-                },
-                Signal::Step {
-                    from: 0.0,
-                    to: -3.0,
-                    at: 1195.0,
-                },
-            ],
-        };
-        let d = sim.run().unwrap();
-        let noise = crate::detect::measurement_noise(&d.pv);
-        let found = inferred(&d.op, &d.pv, noise).expect("the first step");
+        let (op, pv, _, noise) = pi_loop(Some((500.0, 1195.0)));
+        let found = inferred(&op, &pv, noise).expect("the first step");
         assert_eq!(found.steps.len(), 1, "{:?}", found.steps);
         assert!(found.sp.iter().all(|v| v.is_finite()));
-        assert_eq!(found.sp.len(), d.pv.len());
+        assert_eq!(found.sp.len(), pv.len());
     }
 
     /// An OP step after which PV returns to where it was (a feed-forward, an operator) is no
