@@ -123,6 +123,14 @@ pub enum Signal {
         /// The signals added.
         parts: Vec<Signal>,
     },
+    /// A recorded series (another loop's PV, say), `values[j]` at `j * dt` seconds, drawn
+    /// straight between its samples and held at its last value after them.
+    Recorded {
+        /// Seconds between the values.
+        dt: f64,
+        /// The values.
+        values: Vec<f64>,
+    },
 }
 
 impl Signal {
@@ -209,6 +217,13 @@ impl Signal {
                 )
             }
             Signal::Sum { parts } => parts.iter().try_for_each(Signal::validate),
+            Signal::Recorded { dt, values } => {
+                require(*dt > 0.0, "dt", "> 0 seconds", *dt)?;
+                require(!values.is_empty(), "values", "at least one", 0.0)?;
+                values
+                    .iter()
+                    .try_for_each(|&v| require(true, "values", "finite", v))
+            }
         }
     }
 
@@ -327,6 +342,16 @@ impl Signal {
                 }
                 sum
             }
+            Signal::Recorded { dt, ref values } => (0..samples)
+                .map(|k| {
+                    let x = time(k) / dt;
+                    let j = x.floor() as usize;
+                    match (values.get(j), values.get(j + 1)) {
+                        (Some(a), Some(b)) => a + (b - a) * (x - j as f64),
+                        _ => values[values.len() - 1],
+                    }
+                })
+                .collect(),
         }
     }
 }

@@ -557,6 +557,33 @@ fn plant_signals_have_their_shape() {
     .validate()
     .is_err());
 
+    // a recorded series: straight between its values, held after the last
+    let rec = Signal::Recorded {
+        dt: 2.0,
+        values: vec![0.0, 4.0, 2.0],
+    };
+    assert_eq!(
+        rec.generate(1.0, 7),
+        vec![0.0, 2.0, 4.0, 3.0, 2.0, 2.0, 2.0]
+    );
+    assert!(rec.validate().is_ok());
+    for bad in [
+        Signal::Recorded {
+            dt: 0.0,
+            values: vec![1.0],
+        },
+        Signal::Recorded {
+            dt: 1.0,
+            values: vec![],
+        },
+        Signal::Recorded {
+            dt: 1.0,
+            values: vec![1.0, f64::NAN],
+        },
+    ] {
+        assert!(bad.validate().is_err(), "{bad:?}");
+    }
+
     let a = Signal::Sine {
         amplitude: 1.0,
         period: 10.0,

@@ -1,0 +1,298 @@
+//! A plant-wide oscillation: healthy loops disturbed by another loop's sticky valve. The
+//! catalogue's external-oscillation look-alikes (routine and fast, benchmark and calibration
+//! sets) are a sine or narrow-band noise; the oscillation most often met in plants is another
+//! loop's stiction limit cycle, propagated through the process: not sinusoidal (the upstream
+//! valve's jumps, filtered by its process), steady in amplitude, free in phase. Here each
+//! external-oscillation loop is simulated again with its oscillation replaced by such a cycle of
+//! the same period, standard deviation and place (load or PV): an upstream PI loop with a
+//! Stenman valve (band 1-5 %, first-order process with dead time, drawn from the loop's seed) is
+//! simulated, and its PV's deviation, stretched in time to the loop's period, is the oscillation.
+//! Every other part of each loop is the same; each is judged as `stiction diagnose loop.csv --sp
+//! sp` judges it. Outside the benchmark's goals.
+//!
+//!     cargo run --release -p stiction-core --example propagated_oscillation -- [--out docs/propagated-oscillation.md] [--jsonl FILE]
+
+#[path = "common/catalogue_loop.rs"]
+mod catalogue_loop;
+
+use rand::RngExt;
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use stiction_core::diagnose::{diagnose, Diagnosis, Verdict, Vote};
+use stiction_core::models::{Model, Stenman};
+use stiction_core::rng::seeded;
+use stiction_core::sim::catalogue::{catalogue, BenchmarkLoop, LoopClass, Set, Suite};
+use stiction_core::sim::{ClosedLoop, Pi, Process, Signal};
+
+/// The oscillation in a signal: a sine or narrow-band part, alone or in a sum.
+fn oscillation_of(s: &Signal) -> Option<(f64, f64)> {
+    match s {
+        Signal::Sine {
+            amplitude, period, ..
+        }
+        | Signal::NarrowBand {
+            amplitude, period, ..
+        } => Some((*amplitude, *period)),
+        Signal::Sum { parts } => parts.iter().find_map(oscillation_of),
+        _ => None,
+    }
+}
+
+/// `s` with its oscillation replaced by `by`.
+fn replaced(s: &Signal, by: &Signal) -> Signal {
+    match s {
+        Signal::Sine { .. } | Signal::NarrowBand { .. } => by.clone(),
+        Signal::Sum { parts } => Signal::Sum {
+            parts: parts.iter().map(|p| replaced(p, by)).collect(),
+        },
+        other => other.clone(),
+    }
+}
+
+/// What the upstream loop was, in words for the table's key.
+struct Upstream {
+    band: f64,
+    tau: f64,
+    delay: f64,
+}
+
+/// An upstream sticky loop's PV deviation with the standard deviation of a sine of `amplitude`,
+/// stretched to `period` seconds and long enough for `seconds`; `None` when the drawn loop does
+/// not cycle regularly.
+fn upstream_cycle(
+    seed: u64,
+    amplitude: f64,
+    period: f64,
+    seconds: f64,
+) -> Option<(Signal, Upstream)> {
+    let mut rng = seeded(seed ^ 0x005E_ED0F_0A1E_0A57);
+    for _ in 0..8 {
+        let tau = 5.0 + 25.0 * rng.random::<f64>();
+        let delay = 1.0 + 9.0 * rng.random::<f64>();
+        let band = 1.0 + 4.0 * rng.random::<f64>();
+        let mut up = ClosedLoop::new(Model::Stenman(Stenman::new(band).ok()?));
+        up.process = Process::Foptd { k: 1.0, tau, delay };
+        // SIMC with the closed-loop time constant equal to the delay
+        up.pi = Pi {
+            kc: 0.5 * tau / delay,
+            ti: tau.min(8.0 * delay),
+        };
+        up.setpoint = Signal::Constant { value: 50.0 };
+        up.noise = 0.02;
+        up.ts = 1.0;
+        up.seed = rng.random();
+        // its own period in samples first, on a short run
+        up.samples = 3000;
+        let probe = up.run().ok()?;
+        let pv = &probe.pv[1000..];
+        let reg = stiction_core::detect::regularity(&centred(pv), 1.0);
+        let Some(own) = reg.period.filter(|_| reg.regularity >= 1.0) else {
+            continue;
+        };
+        let dt = period / own;
+        up.samples = 1000 + (seconds / dt) as usize + 10;
+        let data = up.run().ok()?;
+        let mut values = centred(&data.pv[1000..]);
+        let sd = (values.iter().map(|v| v * v).sum::<f64>() / values.len() as f64).sqrt();
+        if sd <= 0.0 {
+            continue;
+        }
+        let scale = amplitude / std::f64::consts::SQRT_2 / sd;
+        values.iter_mut().for_each(|v| *v *= scale);
+        return Some((
+            Signal::Recorded { dt, values },
+            Upstream { band, tau, delay },
+        ));
+    }
+    None
+}
+
+fn centred(x: &[f64]) -> Vec<f64> {
+    let m = x.iter().sum::<f64>() / x.len().max(1) as f64;
+    x.iter().map(|v| v - m).collect()
+}
+
+/// The loop with its oscillation replaced by an upstream loop's stiction cycle.
+fn propagated(l: &BenchmarkLoop) -> Option<(BenchmarkLoop, Upstream)> {
+    let mut setup = l.setup.clone();
+    let seconds = setup.warmup + setup.ts * setup.samples as f64;
+    let (amplitude, period) = setup
+        .load
+        .as_ref()
+        .and_then(oscillation_of)
+        .or_else(|| setup.disturbance.as_ref().and_then(oscillation_of))?;
+    let (cycle, up) = upstream_cycle(setup.seed, amplitude, period, seconds)?;
+    if setup.load.as_ref().and_then(oscillation_of).is_some() {
+        setup.load = setup.load.as_ref().map(|s| replaced(s, &cycle));
+    } else {
+        setup.disturbance = setup.disturbance.as_ref().map(|s| replaced(s, &cycle));
+    }
+    let data = setup.run().ok()?;
+    Some((
+        BenchmarkLoop {
+            setup,
+            data,
+            ..l.clone()
+        },
+        up,
+    ))
+}
+
+fn judge(l: &BenchmarkLoop) -> Diagnosis {
+    diagnose(&catalogue_loop::record(l), &catalogue_loop::request(l))
+        .expect("catalogue records are valid requests")
+}
+
+/// Verdict counts: stiction, no_stiction, undetermined or insufficient data.
+#[derive(Default, Clone, Copy)]
+struct Tally([usize; 3]);
+
+impl Tally {
+    fn add(&mut self, v: Verdict) {
+        let i = match v {
+            Verdict::Stiction => 0,
+            Verdict::NoStiction => 1,
+            _ => 2,
+        };
+        self.0[i] += 1;
+    }
+
+    fn cells(&self) -> String {
+        let n: usize = self.0.iter().sum();
+        let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
+        format!(
+            "{} of {n} ({:.1} %) | {:.1} % | {:.1} %",
+            self.0[0],
+            pct(self.0[0]),
+            pct(self.0[1]),
+            pct(self.0[2])
+        )
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let flag = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1).cloned())
+    };
+    let (out, jsonl_path) = (flag("--out"), flag("--jsonl"));
+    let mut jsonl = String::new();
+    let mut md = String::from("# A plant-wide oscillation: another loop's sticky valve\n\n");
+    md.push_str(
+        "Generated by `cargo run --release -p stiction-core --example propagated_oscillation -- --out docs/propagated-oscillation.md`. \
+         The catalogue's external-oscillation look-alikes (healthy valves; routine and fast loops, benchmark and calibration sets) \
+         simulated again with their oscillation (a sine or narrow-band noise, on the load or on PV) replaced by another loop's \
+         stiction limit cycle of the same period, standard deviation and place: an upstream PI loop with a Stenman valve \
+         (band 1-5 %, process gain 1, time constant 5-30 s, dead time 1-10 s, drawn from the loop's seed) is simulated and its \
+         PV's deviation, stretched in time to the loop's period, is the oscillation (not sinusoidal, steady in amplitude, free \
+         in phase, as a propagated plant-wide oscillation is). Every other part of each loop is the same; each is judged as \
+         `stiction diagnose loop.csv --sp sp` judges it. The valve judged is healthy in every loop: a `stiction` verdict is a \
+         false alarm. Outside the benchmark's goals (the catalogue has no such look-alike).\n\n",
+    );
+    let mut rows: BTreeMap<String, (Tally, Tally)> = BTreeMap::new();
+    let mut skipped = 0;
+    // which families voted stiction in the false alarms, each way of disturbing the loop
+    let mut voters: BTreeMap<(&str, String), usize> = BTreeMap::new();
+    for suite in [Suite::Routine, Suite::Fast] {
+        for set in [Set::Calibration, Set::Benchmark] {
+            let loops: Vec<BenchmarkLoop> = catalogue(suite, set)
+                .into_iter()
+                .filter(|l| l.class == LoopClass::ExternalOscillation)
+                .collect();
+            let judged: Vec<_> = loops
+                .par_iter()
+                .map(|l| propagated(l).map(|(p, up)| (l.id.clone(), judge(l), judge(&p), up)))
+                .collect();
+            let name = format!(
+                "{} loops, {} set",
+                match suite {
+                    Suite::Routine => "routine",
+                    Suite::Fast => "fast",
+                },
+                match set {
+                    Set::Calibration => "calibration",
+                    _ => "benchmark",
+                }
+            );
+            for j in judged {
+                let Some((id, plain, spread, up)) = j else {
+                    skipped += 1;
+                    continue;
+                };
+                let line = serde_json::json!({
+                    "id": id, "upstream_band": up.band, "upstream_tau": up.tau, "upstream_delay": up.delay,
+                    "sine": &plain, "propagated": &spread,
+                });
+                let _ = writeln!(jsonl, "{line}");
+                for (how, d) in [
+                    ("sine or narrow-band", &plain),
+                    ("another loop's stiction cycle", &spread),
+                ] {
+                    if d.verdict == Verdict::Stiction {
+                        let who: Vec<String> = d
+                            .families
+                            .iter()
+                            .filter(|f| f.vote == Vote::Stiction)
+                            .map(|f| {
+                                serde_json::to_string(&f.family)
+                                    .unwrap_or_default()
+                                    .replace('"', "")
+                            })
+                            .collect();
+                        *voters.entry((how, who.join(" and "))).or_default() += 1;
+                    }
+                }
+                let (plain, spread) = (plain.verdict, spread.verdict);
+                let bands = if up.band < 2.5 { "1-2.5" } else { "2.5-5" };
+                let speed = if up.tau / up.delay < 4.0 {
+                    "under 4"
+                } else {
+                    "4 or more"
+                };
+                for key in [
+                    name.clone(),
+                    format!("all, upstream band {bands} %"),
+                    format!("all, upstream time constant over dead time {speed}"),
+                ] {
+                    let e = rows.entry(key).or_default();
+                    e.0.add(plain);
+                    e.1.add(spread);
+                }
+            }
+        }
+    }
+    let _ = writeln!(
+        md,
+        "| loops | sine or narrow-band: called `stiction` | `no_stiction` | `undetermined` or `insufficient_data` | another loop's stiction cycle: called `stiction` | `no_stiction` | `undetermined` or `insufficient_data` |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
+    for (key, (plain, spread)) in &rows {
+        let _ = writeln!(md, "| {key} | {} | {} |", plain.cells(), spread.cells());
+    }
+    let _ = writeln!(
+        md,
+        "\nThe false alarms (both sets, routine and fast), by the families that voted stiction:\n\n| oscillation | families voting stiction | loops |\n|---|---|---|"
+    );
+    for ((how, who), n) in &voters {
+        let _ = writeln!(md, "| {how} | {who} | {n} |");
+    }
+    if skipped > 0 {
+        let _ = writeln!(
+            md,
+            "\n{skipped} loops left out: no upstream loop drawn for them cycled regularly in 8 tries."
+        );
+    }
+    if let Some(path) = jsonl_path {
+        std::fs::write(&path, &jsonl).expect("write the lines");
+    }
+    match out {
+        Some(path) => {
+            std::fs::write(&path, &md).expect("write the table");
+            println!("wrote {path}");
+        }
+        None => print!("{md}"),
+    }
+}
