@@ -7,9 +7,9 @@ use crate::common::{closed_stenman, json, ok};
 #[test]
 fn setpoint_steps_are_read_off_a_record_without_sp() {
     let dir = tempfile::tempdir().unwrap();
-    let steps = dir.path().join("steps.csv");
+    let steps_csv = dir.path().join("steps.csv");
     closed_stenman(
-        &steps,
+        &steps_csv,
         "0",
         &[
             "--noise",
@@ -21,13 +21,34 @@ fn setpoint_steps_are_read_off_a_record_without_sp() {
         ],
     );
     // judged without --sp, as an export without the setpoint column is
-    let v = json(&ok(&["diagnose", steps.to_str().unwrap(), "--json"]));
+    let v = json(&ok(&["diagnose", steps_csv.to_str().unwrap(), "--json"]));
     assert_ne!(v["verdict"], "stiction", "{v:#}");
     let warnings = v["warnings"].to_string();
     assert!(
         warnings.contains("setpoint steps read off the record"),
         "{warnings}"
     );
+    // the steps, where the setpoint stepped (every 300 s at 1 s a sample), and the levels between
+    let steps = v["setpoint_read_off"]["steps"].as_array().unwrap();
+    assert!(!steps.is_empty(), "{v:#}");
+    for s in steps {
+        let k = s.as_u64().unwrap();
+        assert!(k % 300 <= 2, "a step read at sample {k}");
+    }
+    assert_eq!(
+        v["setpoint_read_off"]["levels"].as_array().unwrap().len(),
+        steps.len() + 1
+    );
+    // and the report draws them where SP would be
+    let page = dir.path().join("steps.html");
+    ok(&[
+        "report",
+        steps_csv.to_str().unwrap(),
+        "-o",
+        page.to_str().unwrap(),
+    ]);
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("SP read off OP and PV"));
     // the same loop at a steady setpoint: nothing to read off
     let steady = dir.path().join("steady.csv");
     closed_stenman(
@@ -39,4 +60,5 @@ fn setpoint_steps_are_read_off_a_record_without_sp() {
     let warnings = v["warnings"].to_string();
     assert!(warnings.contains("deviation from its mean"), "{warnings}");
     assert!(!warnings.contains("read off"), "{warnings}");
+    assert!(v.get("setpoint_read_off").is_none(), "{v:#}");
 }

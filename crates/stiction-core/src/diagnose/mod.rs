@@ -28,7 +28,9 @@ mod windows;
 pub use evidence::{Family, FamilyEvidence};
 pub use oscillation::noise_std;
 pub use request::{DiagnoseError, DiagnoseRequest};
-pub use result::{Band, BandSource, Diagnosis, Index, Oscillation, Verdict, Vote, WindowVerdict};
+pub use result::{
+    Band, BandSource, Diagnosis, Index, Oscillation, SetpointReadOff, Verdict, Vote, WindowVerdict,
+};
 
 /// The signals of one loop record (op, pv, and when recorded sp, mv, time in seconds, and
 /// `auto`: `true` where the controller is in automatic). Missing values are NaN.
@@ -49,8 +51,8 @@ struct Judged {
     oscillation: Osc,
     decision: verdict::Decision,
     fits: Option<crate::quantify::FitComparison>,
-    /// Without a recorded setpoint, the setpoint steps read off OP and PV ([`setpoint`]).
-    setpoint_steps: usize,
+    /// Without a recorded setpoint, the setpoint read off OP and PV ([`setpoint`]).
+    setpoint: Option<setpoint::Inferred>,
 }
 
 /// The warning on a record without SP begins so.
@@ -121,7 +123,6 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         oscillation,
         indices,
         fits,
-        setpoint_steps,
         ..
     } = ctx;
     Judged {
@@ -130,7 +131,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         oscillation,
         decision,
         fits,
-        setpoint_steps,
+        setpoint: inferred,
     }
 }
 
@@ -223,6 +224,7 @@ pub fn diagnose_checked(
         quantification: None,
         quantified: None,
         windows,
+        setpoint_read_off: None,
         warnings,
         seconds: 0.0,
     };
@@ -239,10 +241,11 @@ pub fn diagnose_checked(
         return Ok(unjudged(d, reason, next_step, started));
     }
     let j = judge(&sub, req);
-    if j.setpoint_steps > 0 {
+    if let Some(read) = &j.setpoint {
         if let Some(w) = d.warnings.iter_mut().find(|w| w.starts_with(NO_SETPOINT)) {
-            *w = setpoint::words(j.setpoint_steps);
+            *w = setpoint::words(read.steps.len());
         }
+        d.setpoint_read_off = Some(read.in_record(s));
     }
     d.verdict = j.decision.verdict;
     d.confidence = j.decision.confidence;

@@ -208,6 +208,25 @@ pub struct WindowVerdict {
     pub votes: Vec<(super::evidence::Family, Vote)>,
 }
 
+/// The setpoint read off a record without SP: PV's settled level between the setpoint's steps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SetpointReadOff {
+    /// The samples of the record at which it steps, in order.
+    pub steps: Vec<usize>,
+    /// Its level from the analysed stretch's start to the first step, then after each step (one
+    /// more than `steps`).
+    pub levels: Vec<f64>,
+}
+
+impl SetpointReadOff {
+    /// The setpoint at every sample of `[start, end)` of the record.
+    pub fn over(&self, [start, end]: [usize; 2]) -> Vec<f64> {
+        (start..end)
+            .map(|k| self.levels[self.steps.partition_point(|&s| s <= k)])
+            .collect()
+    }
+}
+
 /// The diagnosis of one loop.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Diagnosis {
@@ -254,6 +273,10 @@ pub struct Diagnosis {
     /// A verdict per window, when the request asks for windows.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub windows: Vec<WindowVerdict>,
+    /// Without a recorded setpoint, the setpoint read off OP and PV over the analysed stretch
+    /// (`diagnose::setpoint`): where it stepped and the levels between.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub setpoint_read_off: Option<SetpointReadOff>,
     /// What the diagnosis had to assume (e.g. no setpoint recorded).
     pub warnings: Vec<String>,
     /// Time the diagnosis took, seconds.

@@ -43,6 +43,21 @@ pub struct Inferred {
     pub steps: Vec<usize>,
 }
 
+impl Inferred {
+    /// As the diagnosis reports it: the steps as samples of the record whose analysed stretch
+    /// starts at sample `start`, and the levels between.
+    pub fn in_record(&self, start: usize) -> super::SetpointReadOff {
+        super::SetpointReadOff {
+            steps: self.steps.iter().map(|&k| k + start).collect(),
+            levels: [0]
+                .into_iter()
+                .chain(self.steps.iter().copied())
+                .map(|k| self.sp[k])
+                .collect(),
+        }
+    }
+}
+
 /// The setpoint's steps in a record of OP and PV (PV's noise standard deviation `pv_noise`);
 /// `None` when none is found (the setpoint then stays PV's mean).
 pub fn inferred(op: &[f64], pv: &[f64], pv_noise: f64) -> Option<Inferred> {
@@ -197,6 +212,10 @@ mod tests {
                 sp[k]
             );
         }
+        // as the diagnosis reports it, in a record whose analysed stretch starts at sample 10
+        let read = found.in_record(10);
+        assert_eq!(read.steps, vec![found.steps[0] + 10, found.steps[1] + 10]);
+        assert_eq!(read.over([10, 10 + pv.len()]), found.sp);
         let (op, pv, _, noise) = pi_loop(None);
         assert_eq!(inferred(&op, &pv, noise), None);
     }

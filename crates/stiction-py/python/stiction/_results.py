@@ -47,7 +47,9 @@ class Diagnosis(_Result):
     ``insufficient_data``), ``confidence``, ``reason``, ``next_step``, ``band`` (the stiction band
     in % of valve span and where it comes from, for a ``stiction`` verdict), ``families`` (the
     evidence and their votes), ``indices`` (the shape indices), ``oscillation``, ``quality``
-    (the data-quality gates), ``samples``, ``ts``, ``warnings``.
+    (the data-quality gates), ``samples``, ``ts``, ``warnings``; without a setpoint column,
+    ``setpoint_read_off`` (the setpoint's steps read off OP and PV, and the levels between) when
+    any were found.
     """
 
     @property

@@ -56,11 +56,21 @@ fn trend_pair(
         .sp
         .as_ref()
         .map(|sp| series::decimate(&tu, &sp[a..b], buckets));
+    // without SP, the setpoint the diagnosis read off OP and PV, over its analysed stretch
+    let [ra, rb] = [a.max(d.analysed[0]), b.min(d.analysed[1])];
+    let read_off = d
+        .setpoint_read_off
+        .as_ref()
+        .filter(|_| sp.is_none() && ra < rb)
+        .map(|r| series::decimate(&tu[ra - a..rb - a], &r.over([ra, rb]), buckets));
     let sim = q.and_then(|q| model(&q.pv_simulated));
     let mv = q.and_then(|q| model(&q.mv));
     let mut traces = vec![plots::line("PV", &pv, 0)];
     if let Some(sp) = &sp {
         traces.push(plots::line("SP", sp, 2));
+    }
+    if let Some(r) = &read_off {
+        traces.push(plots::steps("SP read off OP and PV", r, 2));
     }
     if let Some(sim) = &sim {
         traces.push(plots::line("PV simulated", sim, 1));
@@ -68,6 +78,11 @@ fn trend_pair(
     let mut caption = String::from("Process variable");
     if sp.is_some() {
         caption.push_str(" and setpoint");
+    }
+    if read_off.is_some() {
+        caption.push_str(
+            " and, with no SP column, the setpoint read off the record (where OP stepped while PV was still and PV then settled at a new level)",
+        );
     }
     if sim.is_some() {
         caption.push_str(
