@@ -5,12 +5,15 @@
 //! valve's jumps, filtered by its process), steady in amplitude, free in phase. Here each
 //! external-oscillation loop is simulated again with its oscillation replaced by such a cycle of
 //! the same period, standard deviation and place (load or PV): an upstream PI loop with a
-//! Stenman valve (band 1-5 %, first-order process with dead time, drawn from the loop's seed) is
+//! Stenman valve (band 1-5 %, first-order process with dead time, PV noise 0.03-0.3 %, drawn from the loop's seed) is
 //! simulated, and its PV's deviation, stretched in time to the loop's period, is the oscillation.
 //! Every other part of each loop is the same; each is judged as `stiction diagnose loop.csv --sp
 //! sp` judges it. Outside the benchmark's goals.
 //!
 //!     cargo run --release -p stiction-core --example propagated_oscillation -- [--out docs/propagated-oscillation.md] [--jsonl FILE]
+//!
+//! Two sections: the cycle where the loop's own oscillation was (load or PV), judged with the setpoint,
+//! and the cycle in the setpoint of a cascade's inner loop, judged without it.
 
 #[path = "common/catalogue_loop.rs"]
 mod catalogue_loop;
@@ -79,7 +82,9 @@ fn upstream_cycle(
             ti: tau.min(8.0 * delay),
         };
         up.setpoint = Signal::Constant { value: 50.0 };
-        up.noise = 0.02;
+        // as noisy as the catalogue's loops (0.03 to 0.3 % of span): the noise is what lets a
+        // limit cycle's phase run free
+        up.noise = 0.03 * 10f64.powf(rng.random::<f64>());
         up.ts = 1.0;
         up.seed = rng.random();
         // its own period in samples first, on a short run
@@ -113,35 +118,75 @@ fn centred(x: &[f64]) -> Vec<f64> {
     x.iter().map(|v| v - m).collect()
 }
 
-/// The loop with its oscillation replaced by an upstream loop's stiction cycle.
-fn propagated(l: &BenchmarkLoop) -> Option<(BenchmarkLoop, Upstream)> {
-    let mut setup = l.setup.clone();
-    let seconds = setup.warmup + setup.ts * setup.samples as f64;
-    let (amplitude, period) = setup
+/// The loop's oscillation (a sine or narrow-band part of its load or of the disturbance on PV)
+/// with its amplitude and period.
+fn its_oscillation(setup: &ClosedLoop) -> Option<(Signal, f64, f64)> {
+    let find = |s: &Signal| -> Option<Signal> {
+        match s {
+            Signal::Sine { .. } | Signal::NarrowBand { .. } => Some(s.clone()),
+            Signal::Sum { parts } => parts.iter().find_map(|p| match p {
+                Signal::Sine { .. } | Signal::NarrowBand { .. } => Some(p.clone()),
+                _ => None,
+            }),
+            _ => None,
+        }
+    };
+    let signal = setup
         .load
         .as_ref()
-        .and_then(oscillation_of)
-        .or_else(|| setup.disturbance.as_ref().and_then(oscillation_of))?;
-    let (cycle, up) = upstream_cycle(setup.seed, amplitude, period, seconds)?;
-    if setup.load.as_ref().and_then(oscillation_of).is_some() {
-        setup.load = setup.load.as_ref().map(|s| replaced(s, &cycle));
-    } else {
-        setup.disturbance = setup.disturbance.as_ref().map(|s| replaced(s, &cycle));
-    }
-    let data = setup.run().ok()?;
-    Some((
-        BenchmarkLoop {
-            setup,
-            data,
-            ..l.clone()
-        },
-        up,
-    ))
+        .and_then(find)
+        .or_else(|| setup.disturbance.as_ref().and_then(find))?;
+    let (amplitude, period) = oscillation_of(&signal)?;
+    Some((signal, amplitude, period))
 }
 
-fn judge(l: &BenchmarkLoop) -> Diagnosis {
-    diagnose(&catalogue_loop::record(l), &catalogue_loop::request(l))
-        .expect("catalogue records are valid requests")
+/// The loop with its oscillation replaced by `by` (the same place), or with `via_setpoint`
+/// taken out of the load and PV and added to the setpoint instead (a cascade's inner loop whose
+/// outer loop carries the cycle).
+fn disturbed(l: &BenchmarkLoop, by: &Signal, via_setpoint: bool) -> Option<BenchmarkLoop> {
+    let mut setup = l.setup.clone();
+    let quiet = Signal::Constant { value: 0.0 };
+    let put = if via_setpoint { &quiet } else { by };
+    if setup.load.as_ref().and_then(oscillation_of).is_some() {
+        setup.load = setup.load.as_ref().map(|s| replaced(s, put));
+    } else {
+        setup.disturbance = setup.disturbance.as_ref().map(|s| replaced(s, put));
+    }
+    if via_setpoint {
+        setup.setpoint = Signal::Sum {
+            parts: vec![setup.setpoint.clone(), by.clone()],
+        };
+    }
+    let data = setup.run().ok()?;
+    Some(BenchmarkLoop {
+        setup,
+        data,
+        ..l.clone()
+    })
+}
+
+/// The loop with its own oscillation and with an upstream loop's stiction cycle in its place
+/// (both moved to the setpoint with `via_setpoint`).
+fn both(l: &BenchmarkLoop, via_setpoint: bool) -> Option<(BenchmarkLoop, BenchmarkLoop, Upstream)> {
+    let (own, amplitude, period) = its_oscillation(&l.setup)?;
+    let seconds = l.setup.warmup + l.setup.ts * l.setup.samples as f64;
+    let (cycle, up) = upstream_cycle(l.setup.seed, amplitude, period, seconds)?;
+    let plain = if via_setpoint {
+        disturbed(l, &own, true)?
+    } else {
+        l.clone()
+    };
+    Some((plain, disturbed(l, &cycle, via_setpoint)?, up))
+}
+
+/// The diagnosis, with the setpoint given (`--sp sp`) or, `via_setpoint`, not (a cascade's inner
+/// loop exported without its moving setpoint).
+fn judge(l: &BenchmarkLoop, via_setpoint: bool) -> Diagnosis {
+    let mut record = catalogue_loop::record(l);
+    if via_setpoint {
+        record.sp = None;
+    }
+    diagnose(&record, &catalogue_loop::request(l)).expect("catalogue records are valid requests")
 }
 
 /// Verdict counts: stiction, no_stiction, undetermined or insufficient data.
@@ -171,27 +216,10 @@ impl Tally {
     }
 }
 
-fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let flag = |name: &str| {
-        args.iter()
-            .position(|a| a == name)
-            .and_then(|i| args.get(i + 1).cloned())
-    };
-    let (out, jsonl_path) = (flag("--out"), flag("--jsonl"));
-    let mut jsonl = String::new();
-    let mut md = String::from("# A plant-wide oscillation: another loop's sticky valve\n\n");
-    md.push_str(
-        "Generated by `cargo run --release -p stiction-core --example propagated_oscillation -- --out docs/propagated-oscillation.md`. \
-         The catalogue's external-oscillation look-alikes (healthy valves; routine and fast loops, benchmark and calibration sets) \
-         simulated again with their oscillation (a sine or narrow-band noise, on the load or on PV) replaced by another loop's \
-         stiction limit cycle of the same period, standard deviation and place: an upstream PI loop with a Stenman valve \
-         (band 1-5 %, process gain 1, time constant 5-30 s, dead time 1-10 s, drawn from the loop's seed) is simulated and its \
-         PV's deviation, stretched in time to the loop's period, is the oscillation (not sinusoidal, steady in amplitude, free \
-         in phase, as a propagated plant-wide oscillation is). Every other part of each loop is the same; each is judged as \
-         `stiction diagnose loop.csv --sp sp` judges it. The valve judged is healthy in every loop: a `stiction` verdict is a \
-         false alarm. Outside the benchmark's goals (the catalogue has no such look-alike).\n\n",
-    );
+/// The loops of both suites and sets, each with its own oscillation and with the upstream cycle,
+/// judged (`via_setpoint`: both moved to the setpoint and judged without it); one line each
+/// appended to `jsonl`, and the section's tables.
+fn section(via_setpoint: bool, jsonl: &mut String) -> String {
     let mut rows: BTreeMap<String, (Tally, Tally)> = BTreeMap::new();
     let mut skipped = 0;
     // which families voted stiction in the false alarms, each way of disturbing the loop
@@ -204,7 +232,16 @@ fn main() {
                 .collect();
             let judged: Vec<_> = loops
                 .par_iter()
-                .map(|l| propagated(l).map(|(p, up)| (l.id.clone(), judge(l), judge(&p), up)))
+                .map(|l| {
+                    both(l, via_setpoint).map(|(plain, p, up)| {
+                        (
+                            l.id.clone(),
+                            judge(&plain, via_setpoint),
+                            judge(&p, via_setpoint),
+                            up,
+                        )
+                    })
+                })
                 .collect();
             let name = format!(
                 "{} loops, {} set",
@@ -223,8 +260,8 @@ fn main() {
                     continue;
                 };
                 let line = serde_json::json!({
-                    "id": id, "upstream_band": up.band, "upstream_tau": up.tau, "upstream_delay": up.delay,
-                    "sine": &plain, "propagated": &spread,
+                    "id": id, "via_setpoint": via_setpoint, "upstream_band": up.band,
+                    "upstream_tau": up.tau, "upstream_delay": up.delay, "sine": &plain, "propagated": &spread,
                 });
                 let _ = writeln!(jsonl, "{line}");
                 for (how, d) in [
@@ -232,17 +269,7 @@ fn main() {
                     ("another loop's stiction cycle", &spread),
                 ] {
                     if d.verdict == Verdict::Stiction {
-                        let who: Vec<String> = d
-                            .families
-                            .iter()
-                            .filter(|f| f.vote == Vote::Stiction)
-                            .map(|f| {
-                                serde_json::to_string(&f.family)
-                                    .unwrap_or_default()
-                                    .replace('"', "")
-                            })
-                            .collect();
-                        *voters.entry((how, who.join(" and "))).or_default() += 1;
+                        *voters.entry((how, voters_of(d))).or_default() += 1;
                     }
                 }
                 let (plain, spread) = (plain.verdict, spread.verdict);
@@ -253,9 +280,9 @@ fn main() {
                     "4 or more"
                 };
                 for key in [
-                    name.clone(),
-                    format!("all, upstream band {bands} %"),
-                    format!("all, upstream time constant over dead time {speed}"),
+                    format!("a {name}"),
+                    format!("b all, upstream band {bands} %"),
+                    format!("c all, upstream time constant over dead time {speed}"),
                 ] {
                     let e = rows.entry(key).or_default();
                     e.0.add(plain);
@@ -264,13 +291,21 @@ fn main() {
             }
         }
     }
+    let mut md = String::new();
     let _ = writeln!(
         md,
         "| loops | sine or narrow-band: called `stiction` | `no_stiction` | `undetermined` or `insufficient_data` | another loop's stiction cycle: called `stiction` | `no_stiction` | `undetermined` or `insufficient_data` |"
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|---|");
     for (key, (plain, spread)) in &rows {
-        let _ = writeln!(md, "| {key} | {} | {} |", plain.cells(), spread.cells());
+        // the key's first letter orders the rows: the sets, then the upstream loops
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} |",
+            &key[2..],
+            plain.cells(),
+            spread.cells()
+        );
     }
     let _ = writeln!(
         md,
@@ -285,6 +320,56 @@ fn main() {
             "\n{skipped} loops left out: no upstream loop drawn for them cycled regularly in 8 tries."
         );
     }
+    md
+}
+
+/// The families that voted stiction, by name, joined.
+fn voters_of(d: &Diagnosis) -> String {
+    let who: Vec<String> = d
+        .families
+        .iter()
+        .filter(|f| f.vote == Vote::Stiction)
+        .map(|f| {
+            serde_json::to_string(&f.family)
+                .unwrap_or_default()
+                .replace('"', "")
+        })
+        .collect();
+    who.join(" and ")
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let flag = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1).cloned())
+    };
+    let (out, jsonl_path) = (flag("--out"), flag("--jsonl"));
+    let mut jsonl = String::new();
+    let mut md = String::from("# A plant-wide oscillation: another loop's sticky valve\n\n");
+    md.push_str(
+        "Generated by `cargo run --release -p stiction-core --example propagated_oscillation -- --out docs/propagated-oscillation.md`. \
+         The catalogue's external-oscillation look-alikes (healthy valves; routine and fast loops, benchmark and calibration sets) \
+         simulated again with their oscillation (a sine or narrow-band noise, on the load or on PV) replaced by another loop's \
+         stiction limit cycle of the same period and standard deviation: an upstream PI loop with a Stenman valve \
+         (band 1-5 %, process gain 1, time constant 5-30 s, dead time 1-10 s, PV noise 0.03-0.3 % of span, drawn from the loop's seed) \
+         is simulated and its PV's deviation, stretched in time to the loop's period, is the oscillation (not sinusoidal, steady in \
+         amplitude, free in phase, as a propagated plant-wide oscillation is). Every other part of each loop is the same. The \
+         valve judged is healthy in every loop: a `stiction` verdict is a false alarm. Outside the benchmark's goals (the \
+         catalogue has no such look-alike).\n\n\
+         ## Through the process: on the load or on PV, where the loop's own oscillation was\n\n\
+         Each loop judged as `stiction diagnose loop.csv --sp sp` judges it.\n\n",
+    );
+    md.push_str(&section(false, &mut jsonl));
+    md.push_str(
+        "\n## Through the setpoint: a cascade's inner loop exported without its setpoint\n\n\
+         The loop's oscillation (its own, and the upstream cycle in its place) taken off the load and PV and added to its \
+         setpoint, as an outer loop that carries the cycle moves an inner loop's setpoint; each judged as \
+         `stiction diagnose loop.csv` judges it, without `--sp` (the setpoint is not in the export; the error is then PV's \
+         deviation from the setpoint read off the record, or from its mean).\n\n",
+    );
+    md.push_str(&section(true, &mut jsonl));
     if let Some(path) = jsonl_path {
         std::fs::write(&path, &jsonl).expect("write the lines");
     }
