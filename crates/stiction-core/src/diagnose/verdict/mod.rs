@@ -380,6 +380,19 @@ fn next_step(
     }
 }
 
+/// Added to a `stiction` verdict's next step when the shape of the cycle alone voted stiction:
+/// another loop's stiction cycle, carried through the process or a cascade's setpoint, gives the
+/// same shapes (the `propagated_oscillation` example; docs/propagated-oscillation.md).
+const SHAPE_ALONE: &str = "only the cycle's shape points to the valve, and another loop's sticky valve cycling this loop \
+gives that shape too (healthy loops cycled by one in simulation: 15 of 116 called stiction on the shape alone): if other \
+loops oscillate at this period, find the one the others follow first";
+
+/// Whether the shape family is the only one voting stiction.
+fn shape_alone(families: &[FamilyEvidence]) -> bool {
+    let mut voters = families.iter().filter(|f| f.vote == Vote::Stiction);
+    voters.next().is_some_and(|f| f.family == Family::Shape) && voters.next().is_none()
+}
+
 fn next_step_of(
     verdict: Verdict,
     confidence: Option<f64>,
@@ -408,6 +421,8 @@ fn next_step_of(
                 .any(|f| f.family == Family::Valve && f.vote == Vote::Stiction)
             {
                 "maintain the valve (packing, actuator, positioner): its recorded position shows the band".into()
+            } else if shape_alone(families) {
+                format!("valve travel test recommended (small OP steps in manual, watching PV or the valve position) to confirm before maintenance; {SHAPE_ALONE}")
             } else {
                 "valve travel test recommended (small OP steps in manual, watching PV or the valve position) to confirm before maintenance".into()
             }

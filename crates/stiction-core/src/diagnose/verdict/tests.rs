@@ -122,3 +122,20 @@ fn the_hidden_valve_outweighs_the_families_that_read_op_as_the_valve_input() {
     against.push(valve);
     assert_eq!(decide(&against, &calm()).verdict, Verdict::NoStiction);
 }
+
+#[test]
+fn a_stiction_verdict_on_the_shape_alone_says_another_loop_can_give_it() {
+    let shape = family(Family::Shape, Vote::Stiction, None);
+    let d = decide(std::slice::from_ref(&shape), &calm());
+    assert_eq!(d.verdict, Verdict::Stiction);
+    assert!(
+        d.next_step.contains("another loop's sticky valve"),
+        "{}",
+        d.next_step
+    );
+    // with the closed-loop fit behind it, the caveat goes
+    let fit = family(Family::Model, Vote::Stiction, None);
+    let d = decide(&[shape, fit], &calm());
+    assert_eq!(d.verdict, Verdict::Stiction);
+    assert!(!d.next_step.contains("another loop"), "{}", d.next_step);
+}
