@@ -303,6 +303,13 @@ fn print_outcome(rows: &[Row], out: &Path, secs: f64, threads: usize, reports: b
             parts.join(", ")
         }
     );
+    let shared = rows.iter().filter(|r| r.same_period_loops > 0).count();
+    if shared > 0 {
+        println!(
+            "  {shared} oscillating loops share their period with others of this batch (same_period_loops in summary.csv): \
+             where they belong to one unit and one time window, one loop's cycle (a sticky valve) may drive the others"
+        );
+    }
     if resume {
         // failed loops are counted apart (they are tried again on every resume)
         let n = |f: Fate, s: SourceStatus| {

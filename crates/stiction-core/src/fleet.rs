@@ -201,6 +201,42 @@ pub fn rank(rows: &mut [Row]) {
     rows.sort_by(ranking);
 }
 
+/// Two loops oscillate at one period when their periods lie within this share of each other: a
+/// cycle carried from loop to loop (another loop's sticky valve, through the process or a
+/// cascade's setpoint) keeps its period, and the estimates scatter by a few percent.
+pub const SAME_PERIOD: f64 = 0.05;
+/// A loop's cycle counts from this regularity (Thornhill's: over 1, a regular oscillation).
+pub const REGULAR: f64 = 1.0;
+
+/// For each row, how many other rows oscillate at its period ([`SAME_PERIOD`]; both regular,
+/// [`REGULAR`]); 0 for a row that does not oscillate. Where several loops of one unit share a
+/// period, one of them may drive the others: a stiction verdict on a loop that shares its period
+/// is read with that in mind (docs/propagated-oscillation.md). Loops from different units or
+/// time windows can share a period by chance.
+pub fn same_period<'a>(rows: impl IntoIterator<Item = &'a Row>) -> Vec<usize> {
+    let periods: Vec<Option<f64>> = rows
+        .into_iter()
+        .map(|r| {
+            r.period_s
+                .filter(|p| p.is_finite() && *p > 0.0)
+                .filter(|_| r.regularity.is_some_and(|g| g >= REGULAR))
+        })
+        .collect();
+    let mut sorted: Vec<f64> = periods.iter().flatten().copied().collect();
+    sorted.sort_by(f64::total_cmp);
+    periods
+        .iter()
+        .map(|p| match p {
+            Some(p) => {
+                let lo = sorted.partition_point(|&q| q < p / (1.0 + SAME_PERIOD));
+                let hi = sorted.partition_point(|&q| q <= p * (1.0 + SAME_PERIOD));
+                hi - lo - 1
+            }
+            None => 0,
+        })
+        .collect()
+}
+
 /// Number of loops per outcome.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
@@ -257,6 +293,27 @@ impl Counts {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// Loops count each other at one period within 5 %, regular ones only; a loop that does not
+    /// oscillate counts none and is counted by none.
+    #[test]
+    fn loops_at_one_period_count_each_other() {
+        let at = |id: &str, period: Option<f64>, regularity: f64| Row {
+            period_s: period,
+            regularity: Some(regularity),
+            ..Row::failed(id, "", String::new())
+        };
+        let rows = [
+            at("a", Some(100.0), 3.0),
+            at("b", Some(104.0), 2.0),
+            at("c", Some(96.0), 5.0),
+            at("d", Some(111.0), 3.0),
+            at("e", Some(100.0), 0.5),
+            at("f", None, 0.0),
+        ];
+        // a: b (4 %) and c (4 %); b: a and c? 104 / 96 = 1.083, so only a; d: none within 5 %
+        assert_eq!(same_period(&rows), vec![2, 1, 1, 0, 0, 0]);
+    }
 
     fn row(id: &str, verdict: Outcome, severity: f64) -> Row {
         Row {

@@ -166,6 +166,8 @@ pub struct Entry<'a> {
     pub source: String,
     pub report: bool,
     pub spark: Option<&'a Spark>,
+    /// Other loops of the fleet that oscillate at this loop's period.
+    pub same_period: usize,
 }
 
 pub fn row(rank: usize, e: &Entry) -> FleetRow {
@@ -184,7 +186,13 @@ pub fn row(rank: usize, e: &Entry) -> FleetRow {
         confidence: cell(r.confidence),
         severity: cell(Some(r.severity)),
         band: cell(r.band_percent_of_span),
-        period: cell(r.period_s),
+        period: match (cell(r.period_s), e.same_period) {
+            (c, 0) => c,
+            (Cell { text, key }, n) => Cell {
+                text: format!("{text} +{n}"),
+                key,
+            },
+        },
         reason: r.reason.clone(),
         spark: e
             .spark

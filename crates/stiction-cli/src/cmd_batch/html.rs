@@ -25,6 +25,7 @@ pub fn write_index(outdir: &Path, rows: &[Row], complete: bool) -> Result<()> {
                 source,
                 report: row.report,
                 spark: row.spark.as_ref(),
+                same_period: row.same_period_loops,
             };
             fleet::row(k + 1, &entry)
         })

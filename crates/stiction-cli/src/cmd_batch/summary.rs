@@ -45,6 +45,9 @@ pub struct Row {
     #[serde(flatten)]
     pub fleet: fleet::Row,
     pub source_status: SourceStatus,
+    /// Other loops of this batch that oscillate at this loop's period
+    /// ([`fleet::same_period`]): set when the summary is written.
+    pub same_period_loops: usize,
     #[serde(skip)]
     pub fate: Fate,
     /// Has an HTML report.
@@ -60,6 +63,7 @@ impl Row {
         Row {
             fleet,
             source_status: SourceStatus::Present,
+            same_period_loops: 0,
             fate,
             report: false,
             spark: None,
@@ -99,7 +103,7 @@ fn text(s: &str) -> Cow<'_, str> {
     }
 }
 
-pub const CSV_HEADER: [&str; 15] = [
+pub const CSV_HEADER: [&str; 16] = [
     "loop_id",
     "source",
     "verdict",
@@ -110,6 +114,7 @@ pub const CSV_HEADER: [&str; 15] = [
     "ellipse_percent_of_span",
     "period_s",
     "regularity",
+    "same_period_loops",
     "reason",
     "samples",
     "seconds",
@@ -144,6 +149,7 @@ fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
                 &cell(f.ellipse_percent_of_span),
                 &cell(f.period_s),
                 &cell(f.regularity),
+                &r.same_period_loops.to_string(),
                 &text(&f.reason),
                 &f.samples.map(|s| s.to_string()).unwrap_or_default(),
                 &cell(f.seconds),
@@ -161,6 +167,10 @@ fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
 /// as it was.
 pub fn write(outdir: &Path, rows: &mut [Row], complete: bool) -> Result<()> {
     rank(rows);
+    let shared = fleet::same_period(rows.iter().map(|r| &r.fleet));
+    for (r, n) in rows.iter_mut().zip(shared) {
+        r.same_period_loops = n;
+    }
     write_csv(&outdir.join("summary.csv"), rows)?;
     let json = SummaryJson {
         complete,

@@ -373,3 +373,41 @@ fn unusable_arguments_stop_with_one_sentence() {
         &["--threads 0"],
     );
 }
+
+/// Loops that oscillate at one period count each other in summary.csv, summary.json, the console
+/// and the fleet page; a loop that does not oscillate counts none.
+#[test]
+fn loops_that_share_a_period_are_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let plant = dir.path().join("unit");
+    std::fs::create_dir_all(&plant).unwrap();
+    // the same sticky loop twice (one cycle seen in two loops) and a healthy one
+    simulate(&plant.join("first.csv"), "2", "1");
+    std::fs::copy(plant.join("first.csv"), plant.join("second.csv")).unwrap();
+    simulate(&plant.join("healthy.csv"), "0", "2");
+    let out = dir.path().join("out");
+    let text = batch(
+        &["batch", s(&plant), "-o", s(&out), "--sp", "sp", "--reports"],
+        0,
+    );
+    assert!(
+        text.contains("2 oscillating loops share their period"),
+        "{text}"
+    );
+    let rows: BTreeMap<String, String> = summary(&out)
+        .into_iter()
+        .map(|r| (r["loop_id"].clone(), r["same_period_loops"].clone()))
+        .collect();
+    assert_eq!(rows["first"], "1");
+    assert_eq!(rows["second"], "1");
+    assert_eq!(rows["healthy"], "0");
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert!(j["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|r| r["same_period_loops"].is_u64()));
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(page.contains(" +1</td>"), "the fleet page");
+}
