@@ -192,5 +192,23 @@ pub fn diagnose_many(
     });
     progress.finish();
     fleet::rank(&mut rows);
+    let shared = fleet::same_period(&rows);
+    let rows: Vec<ManyRow> = rows
+        .iter()
+        .zip(shared)
+        .map(|(row, same_period_loops)| ManyRow {
+            row,
+            same_period_loops,
+        })
+        .collect();
     json(&rows)
+}
+
+/// A fleet row with the other loops of the call that oscillate at its period, as `stiction
+/// batch`'s summary has it.
+#[derive(serde::Serialize)]
+struct ManyRow<'a> {
+    #[serde(flatten)]
+    row: &'a Row,
+    same_period_loops: usize,
 }

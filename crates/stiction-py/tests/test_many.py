@@ -7,7 +7,8 @@ import stiction
 
 def test_rows_ranked_and_a_failing_loop(fleet):
     out = stiction.diagnose_many(fleet, by="loop_id", sp="sp", threads=2, progress=False)
-    assert list(out.columns) == stiction.FLEET_COLUMNS
+    assert list(out.columns) == stiction.MANY_COLUMNS
+    assert (out["same_period_loops"] >= 0).all()
     assert sorted(out["loop_id"]) == ["FIC101", "FIC102", "LIC201", "TIC301"]
     failed = out[out["verdict"] == "failed"]
     assert list(failed["loop_id"]) == ["TIC301"]
@@ -34,3 +35,14 @@ def test_numeric_loop_ids_stay_numbers(fleet):
     f["unit"] = f["loop_id"].map({"FIC101": 101, "FIC102": 102, "LIC201": 201})
     out = stiction.diagnose_many(f, by="unit", sp="sp", quantify=False, progress=False)
     assert sorted(out["loop_id"]) == [101, 102, 201]
+
+
+def test_loops_at_one_period_count_each_other(fleet):
+    # the sticky loop twice under two ids (one cycle seen in two loops), and the healthy one
+    one = fleet[fleet["loop_id"] == "FIC101"]
+    twice = pd.concat([one, one.assign(loop_id="FIC101b")], ignore_index=True)
+    out = stiction.diagnose_many(twice, sp="sp", quantify=False, progress=False).set_index("loop_id")
+    assert out.loc["FIC101", "same_period_loops"] == 1
+    assert out.loc["FIC101b", "same_period_loops"] == 1
+    alone = stiction.diagnose_many(one, sp="sp", quantify=False, progress=False)
+    assert list(alone["same_period_loops"]) == [0]

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from . import _stiction as _native
-from ._many import FLEET_COLUMNS, diagnose_many
+from ._many import FLEET_COLUMNS, MANY_COLUMNS, diagnose_many
 from ._report import report
 from ._results import Diagnosis, Estimate, Quantification
 from ._signals import StictionError, loop_columns, numbers
@@ -31,6 +31,7 @@ __all__ = [
     "Diagnosis",
     "Estimate",
     "FLEET_COLUMNS",
+    "MANY_COLUMNS",
     "He",
     "Kano",
     "Quantification",

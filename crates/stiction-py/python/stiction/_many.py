@@ -30,6 +30,11 @@ FLEET_COLUMNS = [
     "error",
 ]
 
+#: ``diagnose_many``'s columns: :data:`FLEET_COLUMNS`, then ``same_period_loops``, the other loops
+#: of the call that oscillate regularly at the loop's period (within 5 %), as ``stiction batch``'s
+#: summary counts them (not in the Spark front end, which judges each loop apart).
+MANY_COLUMNS = FLEET_COLUMNS + ["same_period_loops"]
+
 
 def _signal(
     frame: pd.DataFrame, name: Optional[str], arg: str, role: str, order: np.ndarray, kind: str,
@@ -95,7 +100,7 @@ def diagnose_many(
     """Diagnose every loop of a long DataFrame (one row per sample, ``by`` names the loop), in
     parallel in Rust with the GIL released, on a pool of ``threads`` (default: one per core).
 
-    Returns one row per loop (columns :data:`FLEET_COLUMNS`: ``stiction batch``'s summary),
+    Returns one row per loop (columns :data:`MANY_COLUMNS`: ``stiction batch``'s summary),
     ranked as ``batch`` ranks: severity (band x confidence) first, then the verdict, then the
     loop id. A loop that cannot be read or diagnosed is a ``failed`` row with its reason; the
     others go on. The result does not depend on ``threads`` (only ``seconds``, the time each
@@ -136,7 +141,7 @@ def diagnose_many(
         threads=threads, progress=progress, failed={g: f"{sources[g]}: {w}" for g, w in bad.items()},
     )
     rows = json.loads(text)
-    out = pd.DataFrame(rows, columns=FLEET_COLUMNS)
+    out = pd.DataFrame(rows, columns=MANY_COLUMNS)
     # the loop ids as they were in the frame (numbers stay numbers)
     original = dict(zip(names, ids))
     out["loop_id"] = [original[i] for i in out["loop_id"]]

@@ -87,7 +87,8 @@ def diagnose(
     )
 
     def one_loop(pdf: pd.DataFrame) -> pd.DataFrame:
-        rows = diagnose_many(pdf, by=by, threads=1, progress=False, **settings)
+        # one loop a group: no other loop to share a period with
+        rows = diagnose_many(pdf, by=by, threads=1, progress=False, **settings)[FLEET_COLUMNS]
         rows["samples"] = rows["samples"].astype("Int64")
         return rows
 
