@@ -380,6 +380,9 @@ fn next_step(
     }
 }
 
+/// A `stiction` verdict's next step without a recorded valve position.
+const TRAVEL_TEST: &str = "valve travel test recommended (small OP steps in manual, watching PV or the valve position) to confirm before maintenance";
+
 /// Added to a `stiction` verdict's next step when the shape of the cycle alone voted stiction:
 /// another loop's stiction cycle, carried through the process or a cascade's setpoint, gives the
 /// same shapes (the `propagated_oscillation` example; docs/propagated-oscillation.md).
@@ -422,9 +425,9 @@ fn next_step_of(
             {
                 "maintain the valve (packing, actuator, positioner): its recorded position shows the band".into()
             } else if shape_alone(families) {
-                format!("valve travel test recommended (small OP steps in manual, watching PV or the valve position) to confirm before maintenance; {SHAPE_ALONE}")
+                format!("{TRAVEL_TEST}; {SHAPE_ALONE}")
             } else {
-                "valve travel test recommended (small OP steps in manual, watching PV or the valve position) to confirm before maintenance".into()
+                TRAVEL_TEST.into()
             }
         }
         Verdict::NoStiction if voted(Family::Loop, Vote::NoStiction) => {
