@@ -10,6 +10,9 @@
 
 #[path = "common/catalogue_loop.rs"]
 mod catalogue_loop;
+#[path = "common/tally.rs"]
+mod tally;
+use tally::Tally;
 
 use rand::RngExt;
 use rayon::prelude::*;
@@ -57,33 +60,6 @@ fn judge(l: &BenchmarkLoop) -> Verdict {
     diagnose(&catalogue_loop::record(l), &catalogue_loop::request(l))
         .expect("catalogue records are valid requests")
         .verdict
-}
-
-/// Verdict counts: stiction, no_stiction, undetermined or insufficient data.
-#[derive(Default, Clone, Copy)]
-struct Tally([usize; 3]);
-
-impl Tally {
-    fn add(&mut self, v: Verdict) {
-        let i = match v {
-            Verdict::Stiction => 0,
-            Verdict::NoStiction => 1,
-            _ => 2,
-        };
-        self.0[i] += 1;
-    }
-
-    fn cells(&self) -> String {
-        let n: usize = self.0.iter().sum();
-        let pct = |k: usize| 100.0 * k as f64 / n.max(1) as f64;
-        format!(
-            "{} of {n} ({:.1} %) | {:.1} % | {:.1} %",
-            self.0[0],
-            pct(self.0[0]),
-            pct(self.0[1]),
-            pct(self.0[2])
-        )
-    }
 }
 
 fn main() {

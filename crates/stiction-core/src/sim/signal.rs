@@ -342,18 +342,23 @@ impl Signal {
                 }
                 sum
             }
-            Signal::Recorded { dt, ref values } => (0..samples)
-                .map(|k| {
-                    let x = time(k) / dt;
-                    let j = x.floor() as usize;
-                    match (values.get(j), values.get(j + 1)) {
-                        (Some(a), Some(b)) => a + (b - a) * (x - j as f64),
-                        _ => values[values.len() - 1],
-                    }
-                })
-                .collect(),
+            Signal::Recorded { dt, ref values } => recorded(values, dt, ts, samples),
         }
     }
+}
+
+/// `values` (one every `dt` seconds) at `k * ts`, straight between them, the last held after.
+fn recorded(values: &[f64], dt: f64, ts: f64, samples: usize) -> Vec<f64> {
+    (0..samples)
+        .map(|k| {
+            let x = k as f64 * ts / dt;
+            let j = x.floor() as usize;
+            match (values.get(j), values.get(j + 1)) {
+                (Some(a), Some(b)) => a + (b - a) * (x - j as f64),
+                _ => values[values.len() - 1],
+            }
+        })
+        .collect()
 }
 
 fn random_steps(
