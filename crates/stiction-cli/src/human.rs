@@ -138,6 +138,22 @@ fn evidence(d: &Diagnosis) {
     }
 }
 
+/// The setpoint read off a record without SP, its levels and where it stepped (the first few).
+fn read_off(r: &stiction_core::diagnose::SetpointReadOff) -> String {
+    const SHOWN: usize = 8;
+    let mut parts = vec![format!("{:.4}", r.levels[0])];
+    for (step, level) in r.steps.iter().zip(&r.levels[1..]).take(SHOWN) {
+        parts.push(format!("{level:.4} from sample {step}"));
+    }
+    if r.steps.len() > SHOWN {
+        parts.push(format!("{} more steps", r.steps.len() - SHOWN));
+    }
+    format!(
+        "setpoint read off OP and PV (no setpoint column): {}",
+        parts.join(", then ")
+    )
+}
+
 /// The record: samples, oscillation, data quality and the windows.
 fn record(d: &Diagnosis) {
     println!(
@@ -161,6 +177,9 @@ fn record(d: &Diagnosis) {
             o.regularity.threshold,
             o.iae.exceedances
         );
+    }
+    if let Some(r) = &d.setpoint_read_off {
+        println!("  {}", read_off(r));
     }
     let failed: Vec<_> = d.quality.iter().filter(|f| !f.passed).collect();
     if failed.is_empty() {

@@ -39,6 +39,13 @@ fn setpoint_steps_are_read_off_a_record_without_sp() {
         v["setpoint_read_off"]["levels"].as_array().unwrap().len(),
         steps.len() + 1
     );
+    // the human output lists them
+    let text = ok(&["diagnose", steps_csv.to_str().unwrap()]);
+    assert!(
+        text.contains("setpoint read off OP and PV (no setpoint column): "),
+        "{text}"
+    );
+    assert!(text.contains(", then "), "{text}");
     // and the report draws them where SP would be
     let page = dir.path().join("steps.html");
     ok(&[
