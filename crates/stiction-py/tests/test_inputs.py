@@ -123,3 +123,18 @@ def test_errors_name_the_column_and_the_fix(loop):
     df["mode"] = "sometimes"
     with pytest.raises(ValueError, match=r"row 0, column 'mode': 'sometimes' is not a controller mode"):
         stiction.diagnose(df, mode="mode")
+
+
+def test_a_record_without_its_setpoint_has_the_setpoint_read_off():
+    # a healthy PI loop whose setpoint stepped, judged without its sp column
+    df = stiction.simulate(
+        "stenman", "closed", d=0.0, noise=0.05, seed=3, samples=1500,
+        sp="steps:amplitude=2,hold=300,offset=50,seed=1",
+    )
+    d = stiction.diagnose(df.drop(columns="sp"), quantify=False)
+    read = d.setpoint_read_off
+    assert read["steps"] and all(k % 300 <= 2 for k in read["steps"])
+    assert len(read["levels"]) == len(read["steps"]) + 1
+    assert any("setpoint steps read off the record" in w for w in d.warnings)
+    # with the column given, nothing is read off
+    assert "setpoint_read_off" not in stiction.diagnose(df, sp="sp", quantify=False).keys()
