@@ -383,17 +383,22 @@ fn next_step(
 /// A `stiction` verdict's next step without a recorded valve position.
 const TRAVEL_TEST: &str = "valve travel test recommended (small OP steps in manual, watching PV or the valve position) to confirm before maintenance";
 
-/// Added to a `stiction` verdict's next step when the shape of the cycle alone voted stiction:
-/// another loop's stiction cycle, carried through the process or a cascade's setpoint, gives the
-/// same shapes (the `propagated_oscillation` example; docs/propagated-oscillation.md).
-const SHAPE_ALONE: &str = "only the cycle's shape points to the valve, and another loop's sticky valve cycling this loop \
-gives that shape too (healthy loops cycled by one in simulation: 15 of 116 called stiction on the shape alone): if other \
-loops oscillate at this period, find the one the others follow first";
+/// Added to a `stiction` verdict's next step when only the cycle voted stiction (its shape, or
+/// its steady, free-running rhythm): another loop's stiction cycle, carried through the process
+/// or a cascade's setpoint, gives both (the `propagated_oscillation` example;
+/// docs/propagated-oscillation.md).
+const CYCLE_ALONE: &str = "only the cycle (its shape or its steady, free-running rhythm) points to the valve, and another \
+loop's sticky valve cycling this loop gives that too (healthy loops cycled by one in simulation: 38 of 236 called stiction \
+on the cycle alone): if other loops oscillate at this period, find the one the others follow first";
 
-/// Whether the shape family is the only one voting stiction.
-fn shape_alone(families: &[FamilyEvidence]) -> bool {
-    let mut voters = families.iter().filter(|f| f.vote == Vote::Stiction);
-    voters.next().is_some_and(|f| f.family == Family::Shape) && voters.next().is_none()
+/// Whether only the families that read the cycle itself (its shape, the loop's limit cycle) vote
+/// stiction.
+fn cycle_alone(families: &[FamilyEvidence]) -> bool {
+    let mut voters = families
+        .iter()
+        .filter(|f| f.vote == Vote::Stiction)
+        .peekable();
+    voters.peek().is_some() && voters.all(|f| matches!(f.family, Family::Shape | Family::Loop))
 }
 
 fn next_step_of(
@@ -424,8 +429,8 @@ fn next_step_of(
                 .any(|f| f.family == Family::Valve && f.vote == Vote::Stiction)
             {
                 "maintain the valve (packing, actuator, positioner): its recorded position shows the band".into()
-            } else if shape_alone(families) {
-                format!("{TRAVEL_TEST}; {SHAPE_ALONE}")
+            } else if cycle_alone(families) {
+                format!("{TRAVEL_TEST}; {CYCLE_ALONE}")
             } else {
                 TRAVEL_TEST.into()
             }

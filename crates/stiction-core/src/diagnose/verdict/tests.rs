@@ -124,15 +124,22 @@ fn the_hidden_valve_outweighs_the_families_that_read_op_as_the_valve_input() {
 }
 
 #[test]
-fn a_stiction_verdict_on_the_shape_alone_says_another_loop_can_give_it() {
+fn a_stiction_verdict_on_the_cycle_alone_says_another_loop_can_give_it() {
     let shape = family(Family::Shape, Vote::Stiction, None);
-    let d = decide(std::slice::from_ref(&shape), &calm());
-    assert_eq!(d.verdict, Verdict::Stiction);
-    assert!(
-        d.next_step.contains("another loop's sticky valve"),
-        "{}",
-        d.next_step
-    );
+    let cycle = family(Family::Loop, Vote::Stiction, None);
+    for alone in [
+        vec![shape.clone()],
+        vec![cycle.clone()],
+        vec![shape.clone(), cycle],
+    ] {
+        let d = decide(&alone, &calm());
+        assert_eq!(d.verdict, Verdict::Stiction);
+        assert!(
+            d.next_step.contains("another loop's sticky valve"),
+            "{}",
+            d.next_step
+        );
+    }
     // with the closed-loop fit behind it, the caveat goes
     let fit = family(Family::Model, Vote::Stiction, None);
     let d = decide(&[shape, fit], &calm());
