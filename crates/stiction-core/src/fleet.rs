@@ -203,8 +203,10 @@ pub fn rank(rows: &mut [Row]) {
 
 /// Two loops oscillate at one period when their periods lie within this share of each other: a
 /// cycle carried from loop to loop (another loop's sticky valve, through the process or a
-/// cascade's setpoint) keeps its period, and the estimates scatter by a few percent.
-pub const SAME_PERIOD: f64 = 0.05;
+/// cascade's setpoint) keeps its period, but its estimate in a loop it reaches scatters (the
+/// `propagated_oscillation` example: 54 % of the regular ones within 5 % of the source's period,
+/// 73 % within 10 %).
+pub const SAME_PERIOD: f64 = 0.10;
 /// A loop's cycle counts from this regularity (Thornhill's: over 1, a regular oscillation).
 pub const REGULAR: f64 = 1.0;
 
@@ -294,7 +296,7 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    /// Loops count each other at one period within 5 %, regular ones only; a loop that does not
+    /// Loops count each other at one period within 10 %, regular ones only; a loop that does not
     /// oscillate counts none and is counted by none.
     #[test]
     fn loops_at_one_period_count_each_other() {
@@ -311,8 +313,9 @@ mod tests {
             at("e", Some(100.0), 0.5),
             at("f", None, 0.0),
         ];
-        // a: b (4 %) and c (4 %); b: a and c? 104 / 96 = 1.083, so only a; d: none within 5 %
-        assert_eq!(same_period(&rows), vec![2, 1, 1, 0, 0, 0]);
+        // a: b and c, not d (111 / 100 = 1.11); b: a, c and d (111 / 104 = 1.07); c: a and b
+        // (111 / 96 = 1.16); d: b only; e is not regular, f does not oscillate
+        assert_eq!(same_period(&rows), vec![2, 3, 2, 1, 0, 0]);
     }
 
     fn row(id: &str, verdict: Outcome, severity: f64) -> Row {

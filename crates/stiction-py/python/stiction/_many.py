@@ -31,7 +31,7 @@ FLEET_COLUMNS = [
 ]
 
 #: ``diagnose_many``'s columns: :data:`FLEET_COLUMNS`, then ``same_period_loops``, the other loops
-#: of the call that oscillate regularly at the loop's period (within 5 %), as ``stiction batch``'s
+#: of the call that oscillate regularly at the loop's period (within 10 %), as ``stiction batch``'s
 #: summary counts them (not in the Spark front end, which judges each loop apart).
 MANY_COLUMNS = FLEET_COLUMNS + ["same_period_loops"]
 
