@@ -391,6 +391,17 @@ const CYCLE_ALONE: &str = "only the cycle (its shape or its steady, free-running
 loop's sticky valve cycling this loop gives that too (healthy loops cycled by one in simulation: 38 of 236 called stiction \
 on the cycle alone): if other loops oscillate at this period, find the one the others follow first";
 
+/// Whether the loop family found the identified linear loop at its stability limit at the
+/// cycle's period.
+fn marginal_loop(families: &[FamilyEvidence]) -> bool {
+    families.iter().any(|f| {
+        f.family == Family::Loop
+            && f.limit_cycle
+                .as_ref()
+                .is_some_and(|e| e.linear_loop_sustains())
+    })
+}
+
 /// Whether only the families that read the cycle itself (its shape, the loop's limit cycle) vote
 /// stiction.
 fn cycle_alone(families: &[FamilyEvidence]) -> bool {
@@ -440,6 +451,11 @@ fn next_step_of(
         }
         Verdict::NoStiction if op_does_not_drive => {
             "look upstream: OP does not drive this variation (an external disturbance or an interacting loop)".into()
+        }
+        Verdict::NoStiction if voted(Family::Shape, Vote::NoStiction) && marginal_loop(families) => {
+            "check the tuning first: the cycle is sinusoidal and the identified loop sits at its stability limit at its period \
+             (aggressive tuning gives that, and so does a sticky valve whose band is small beside the cycle): if the cycle stays \
+             once the loop is detuned, test the valve".into()
         }
         Verdict::NoStiction if voted(Family::Shape, Vote::NoStiction) => {
             "the valve is not the cause: check the tuning and disturbances at the oscillation's period".into()

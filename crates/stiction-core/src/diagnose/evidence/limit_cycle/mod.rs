@@ -242,6 +242,15 @@ pub struct LoopEvidence {
     pub calibration: String,
 }
 
+impl LoopEvidence {
+    /// Whether the identified linear loop sustains the cycle by itself: it needs no valve lag
+    /// (under [`LINEAR_LAG`]) and a gain within [`LINEAR_GAIN`] of 1, i.e. it sits at its
+    /// stability limit at the cycle's period (aggressive tuning, or a band small beside the cycle).
+    pub fn linear_loop_sustains(&self) -> bool {
+        self.needed_lag_degrees.abs() < LINEAR_LAG && (self.needed_gain - 1.0).abs() < LINEAR_GAIN
+    }
+}
+
 impl EvidenceFamily for LimitCycle {
     fn family(&self) -> Family {
         Family::Loop

@@ -198,3 +198,33 @@ fn a_long_record_lets_a_steady_amplitude_scatter_more() {
     let swelling = marginal_over(200, 0.5, 0.1, 5.0, true);
     assert_eq!(swelling.vote, Vote::Undetermined, "{}", swelling.note);
 }
+
+/// A sinusoidal cycle in a loop at its stability limit (ISDB's CHEM11 is one, with a sticky
+/// valve): the shape family's `no_stiction` is kept, but the next step asks to detune first and
+/// to test the valve if the cycle stays, not to rule the valve out.
+#[test]
+fn a_sinusoidal_cycle_at_the_stability_limit_asks_to_detune_first() {
+    let mut e: LoopEvidence = serde_json::from_str(SHORT_CYCLE).unwrap();
+    e.needed_lag_degrees = 5.0;
+    e.needed_gain = 1.04;
+    e.harmonics = Some(0.005);
+    e.harmonic_count = 3;
+    let looped = super::vote::vote(e, "", String::new());
+    assert_eq!(looped.vote, Vote::Undetermined);
+    let shape = vote(Family::Shape, Vote::NoStiction, 0.33);
+    let d = decide(&[shape.clone(), looped], &oscillating());
+    assert_eq!(d.verdict, Verdict::NoStiction);
+    assert!(
+        d.next_step.contains("check the tuning first"),
+        "{}",
+        d.next_step
+    );
+    assert!(d.next_step.contains("test the valve"), "{}", d.next_step);
+    // without the loop at its limit, the cycle's shape rules the valve out as before
+    let d = decide(&[shape], &oscillating());
+    assert!(
+        d.next_step.starts_with("the valve is not the cause"),
+        "{}",
+        d.next_step
+    );
+}

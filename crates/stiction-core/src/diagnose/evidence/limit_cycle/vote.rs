@@ -1,10 +1,10 @@
 //! The loop family's vote on what it measured, and its note in words.
 
 use super::{
-    LoopEvidence, StictionBasis, FREE_RUNNING, FULL_LAG, LIMIT_CYCLES, LINEAR_GAIN, LINEAR_LAG,
-    MAX_CONTROLLER_RESIDUAL, MAX_DISTANCE, MAX_LAG, MAX_RESIDUAL, MIN_LAG, MIN_MARGIN, NO_SETPOINT,
-    SATURATION_STRENGTH, SELF_SUSTAINED, STEADY_CYCLES, STEADY_SCATTER, STEADY_SCATTER_LONG,
-    UNSTEADY_CHANGE, UNSTEADY_SCATTER,
+    LoopEvidence, StictionBasis, FREE_RUNNING, FULL_LAG, LIMIT_CYCLES, MAX_CONTROLLER_RESIDUAL,
+    MAX_DISTANCE, MAX_LAG, MAX_RESIDUAL, MIN_LAG, MIN_MARGIN, NO_SETPOINT, SATURATION_STRENGTH,
+    SELF_SUSTAINED, STEADY_CYCLES, STEADY_SCATTER, STEADY_SCATTER_LONG, UNSTEADY_CHANGE,
+    UNSTEADY_SCATTER,
 };
 use crate::diagnose::evidence::{Family, FamilyEvidence};
 use crate::diagnose::result::Vote;
@@ -56,7 +56,6 @@ fn distorted(e: &LoopEvidence) -> bool {
 }
 
 fn ballot(e: &LoopEvidence) -> Ballot {
-    let lag = e.needed_lag_degrees;
     if e.op_at_limit >= LIMIT_CYCLES {
         return (
             Vote::NoStiction,
@@ -83,7 +82,7 @@ fn ballot(e: &LoopEvidence) -> Ballot {
     if let Some(w) = self_sustained(e) {
         return self_sustained_ballot(e, w);
     }
-    if lag.abs() < LINEAR_LAG && (e.needed_gain - 1.0).abs() < LINEAR_GAIN {
+    if e.linear_loop_sustains() {
         let (change, scatter) = e
             .amplitude
             .as_ref()
