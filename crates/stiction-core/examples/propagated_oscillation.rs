@@ -18,8 +18,11 @@
 
 #[path = "common/catalogue_loop.rs"]
 mod catalogue_loop;
+#[path = "common/study_args.rs"]
+mod study_args;
 #[path = "common/tally.rs"]
 mod tally;
+use study_args::StudyArgs;
 use tally::Tally;
 
 use rand::RngExt;
@@ -326,13 +329,7 @@ fn voters_of(d: &Diagnosis) -> String {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let flag = |name: &str| {
-        args.iter()
-            .position(|a| a == name)
-            .and_then(|i| args.get(i + 1).cloned())
-    };
-    let (out, jsonl_path) = (flag("--out"), flag("--jsonl"));
+    let args = StudyArgs::from_env("propagated_oscillation");
     let mut jsonl = String::new();
     let mut md = String::from("# A plant-wide oscillation: another loop's sticky valve\n\n");
     md.push_str(
@@ -358,14 +355,9 @@ fn main() {
          deviation from the setpoint read off the record, or from its mean).\n\n",
     );
     md.push_str(&section(true, &mut jsonl));
-    if let Some(path) = jsonl_path {
-        std::fs::write(&path, &jsonl).expect("write the lines");
+    if let Some(path) = args.value("--jsonl") {
+        std::fs::write(path, &jsonl)
+            .unwrap_or_else(|e| args.fail(&format!("{path}: cannot write: {e}")));
     }
-    match out {
-        Some(path) => {
-            std::fs::write(&path, &md).expect("write the table");
-            println!("wrote {path}");
-        }
-        None => print!("{md}"),
-    }
+    args.emit(&md);
 }

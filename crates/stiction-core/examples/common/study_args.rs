@@ -29,6 +29,7 @@ impl StudyArgs {
     }
 
     /// The catalogue set: the benchmark seeds with `--benchmark`, else the calibration seeds.
+    #[allow(dead_code)]
     pub fn set(&self) -> Set {
         if self.args.iter().any(|a| a == "--benchmark") {
             Set::Benchmark
