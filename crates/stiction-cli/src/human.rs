@@ -4,6 +4,9 @@
 use crate::words::{count, seconds};
 use stiction_core::diagnose::{BandSource, Diagnosis, Verdict, Vote};
 
+/// The oscillation line's answer for a weak cycle (`Oscillation::weak_cycle`).
+const WEAK_CYCLE: &str = "yes, a weak cycle (its half periods clear 1.5 noise standard deviations, not 3, and its period wanders as a limit cycle's does beside noise)";
+
 fn band_source(s: BandSource) -> &'static str {
     match s {
         BandSource::Valve => "from the recorded valve position",
@@ -167,9 +170,10 @@ fn record(d: &Diagnosis) {
     if let Some(o) = &d.oscillation {
         println!(
             "  oscillation: {}; period {}; regularity {:.2} (threshold {}); {} half periods with a large IAE",
-            match (o.oscillating, o.across_setpoint_steps) {
-                (true, true) => "yes, across the setpoint's steps (its holds are too short)",
-                (true, false) => "yes",
+            match (o.oscillating, o.across_setpoint_steps, o.weak_cycle) {
+                (true, true, _) => "yes, across the setpoint's steps (its holds are too short)",
+                (true, false, true) => WEAK_CYCLE,
+                (true, false, false) => "yes",
                 _ => "no",
             },
             o.period.map_or("-".into(), |p| format!("{p:.1} s")),

@@ -563,3 +563,34 @@ fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
     let v = judge(&integrating_loop(dir.path(), "0"));
     assert_ne!(v["verdict"], "stiction", "{v:#}");
 }
+
+/// A sticky valve's cycle only 2.5 noise standard deviations high (Stenman 0.5 %, PV noise 0.45)
+/// is a weak cycle: an oscillation, and said to be one; the healthy valve's loop in the same
+/// noise has none.
+#[test]
+fn a_weak_cycle_is_an_oscillation_and_said_to_be_weak() {
+    let dir = tempfile::tempdir().unwrap();
+    let extra = ["--noise", "0.45", "--seed", "4", "--samples", "2000"];
+    let judge = |f: &str| {
+        json(&ok(&[
+            "diagnose",
+            f,
+            "--sp",
+            "sp",
+            "--no-quantify",
+            "--json",
+        ]))
+    };
+    let f = closed_loop(dir.path(), "weak.csv", "0.5", &extra);
+    let v = judge(&f);
+    let o = &v["oscillation"];
+    assert_eq!(o["oscillating"], true, "{o:#}");
+    assert_eq!(o["weak_cycle"], true, "{o:#}");
+    assert!(o["iae"]["exceedances"].as_u64().unwrap() < 4, "{o:#}");
+    let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
+    assert!(text.contains("oscillation: yes, a weak cycle"), "{text}");
+    let v = judge(&closed_loop(dir.path(), "healthy.csv", "0", &extra));
+    let o = &v["oscillation"];
+    assert_eq!(o["oscillating"], false, "{o:#}");
+    assert!(o.get("weak_cycle").is_none(), "{o:#}");
+}

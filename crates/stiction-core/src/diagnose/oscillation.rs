@@ -187,10 +187,12 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
     let cycle_share = period.and_then(|p| cycle_share(&acf, error.len(), p / ts));
     // an oscillation that stands out of the noise, found by either detector (a regular period
     // stands out of noise at a smaller amplitude than a count of large areas)
-    let regular = regularity.oscillating
-        && amp > REGULAR_AMPLITUDE * noise
-        && (iae.exceedances >= 4 || weak_free_cycle(error, ts, &settings, &regularity, noise));
-    let oscillating = regular || (iae.oscillating && amp > 3.0 * noise);
+    let above = regularity.oscillating && amp > REGULAR_AMPLITUDE * noise;
+    let weak_cycle =
+        above && iae.exceedances < 4 && weak_free_cycle(error, ts, &settings, &regularity, noise);
+    let regular = above && (iae.exceedances >= 4 || weak_cycle);
+    let counted = iae.oscillating && amp > 3.0 * noise;
+    let oscillating = regular || counted;
     Oscillation {
         oscillating,
         period,
@@ -201,6 +203,7 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
         amplitude: amp,
         stretch: [stretch.0, stretch.1],
         across_setpoint_steps: false,
+        weak_cycle: weak_cycle && !counted,
         cycle_share,
     }
 }
@@ -316,7 +319,7 @@ mod tests {
             o.regularity.regularity < 10.0 && o.regularity.oscillating,
             "{o:?}"
         );
-        assert!(o.oscillating, "{o:?}");
+        assert!(o.oscillating && o.weak_cycle, "{o:?}");
         // the same cycle keeping a clock's time is an input's: not counted
         let o = oscillation(&clock, 1.0, (0, n));
         assert!(

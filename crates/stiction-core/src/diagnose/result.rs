@@ -94,6 +94,11 @@ pub struct Oscillation {
     /// variance in the cycle, and the setpoint moves in steps no more often than once a period.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub across_setpoint_steps: bool,
+    /// A weak cycle: regular, but its half periods' areas clear 1.5 noise standard deviations
+    /// only (not Hägglund's 3), and its period wanders as a limit cycle's does beside the noise
+    /// (regularity under 100: one that kept time like a clock would be an input's).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub weak_cycle: bool,
     /// Share of the control error's variance in its cycle (from the autocorrelation at the period
     /// and half of it), when a period was found.
     #[serde(default, skip_serializing_if = "Option::is_none")]
