@@ -492,21 +492,23 @@ fn closed_loop(dir: &Path, name: &str, d: &str, extra: &[&str]) -> String {
     path
 }
 
+/// `stiction diagnose FILE --sp sp --no-quantify --json`, parsed.
+fn sp_json(f: &str) -> serde_json::Value {
+    json(&ok(&[
+        "diagnose",
+        f,
+        "--sp",
+        "sp",
+        "--no-quantify",
+        "--json",
+    ]))
+}
+
 #[test]
 fn a_cycle_across_short_setpoint_holds_is_judged_across_them_and_said() {
     let dir = tempfile::tempdir().unwrap();
-    let judge = |f: &str| {
-        json(&ok(&[
-            "diagnose",
-            f,
-            "--sp",
-            "sp",
-            "--no-quantify",
-            "--json",
-        ]))
-    };
     let f = short_holds(dir.path(), "2");
-    let v = judge(&f);
+    let v = sp_json(&f);
     assert_eq!(v["verdict"], "stiction", "{v:#}");
     let o = &v["oscillation"];
     assert_eq!(o["oscillating"], true, "{o:#}");
@@ -516,7 +518,7 @@ fn a_cycle_across_short_setpoint_holds_is_judged_across_them_and_said() {
     let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
     assert!(text.contains("across the setpoint's steps"), "{text}");
     // the same loop with a healthy valve has no cycle to find across its steps
-    let v = judge(&short_holds(dir.path(), "0"));
+    let v = sp_json(&short_holds(dir.path(), "0"));
     assert_ne!(v["verdict"], "stiction", "{v:#}");
     let o = &v["oscillation"];
     assert!(o.get("across_setpoint_steps").is_none(), "{o:#}");
@@ -536,7 +538,7 @@ fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
     // stiction did worse than the linear loop (`no_stiction`, while `quantify` found d = 2.0)
     let dir = tempfile::tempdir().unwrap();
     let judge = |f: &str| json(&ok(&["diagnose", f, "--sp", "sp", "--json"]));
-    let v = judge(&integrating_loop(dir.path(), "2"));
+    let v = sp_json(&integrating_loop(dir.path(), "2"));
     assert_eq!(v["verdict"], "stiction", "{v:#}");
     let model = v["families"]
         .as_array()
@@ -560,7 +562,7 @@ fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
         "{m:#}"
     );
     // the same loop with a healthy valve
-    let v = judge(&integrating_loop(dir.path(), "0"));
+    let v = sp_json(&integrating_loop(dir.path(), "0"));
     assert_ne!(v["verdict"], "stiction", "{v:#}");
 }
 
@@ -571,25 +573,15 @@ fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
 fn a_weak_cycle_is_an_oscillation_and_said_to_be_weak() {
     let dir = tempfile::tempdir().unwrap();
     let extra = ["--noise", "0.45", "--seed", "4", "--samples", "2000"];
-    let judge = |f: &str| {
-        json(&ok(&[
-            "diagnose",
-            f,
-            "--sp",
-            "sp",
-            "--no-quantify",
-            "--json",
-        ]))
-    };
     let f = closed_loop(dir.path(), "weak.csv", "0.5", &extra);
-    let v = judge(&f);
+    let v = sp_json(&f);
     let o = &v["oscillation"];
     assert_eq!(o["oscillating"], true, "{o:#}");
     assert_eq!(o["weak_cycle"], true, "{o:#}");
     assert!(o["iae"]["exceedances"].as_u64().unwrap() < 4, "{o:#}");
     let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
     assert!(text.contains("oscillation: yes, a weak cycle"), "{text}");
-    let v = judge(&closed_loop(dir.path(), "healthy.csv", "0", &extra));
+    let v = sp_json(&closed_loop(dir.path(), "healthy.csv", "0", &extra));
     let o = &v["oscillation"];
     assert_eq!(o["oscillating"], false, "{o:#}");
     assert!(o.get("weak_cycle").is_none(), "{o:#}");
