@@ -538,7 +538,7 @@ fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
     // stiction did worse than the linear loop (`no_stiction`, while `quantify` found d = 2.0)
     let dir = tempfile::tempdir().unwrap();
     let judge = |f: &str| json(&ok(&["diagnose", f, "--sp", "sp", "--json"]));
-    let v = sp_json(&integrating_loop(dir.path(), "2"));
+    let v = judge(&integrating_loop(dir.path(), "2"));
     assert_eq!(v["verdict"], "stiction", "{v:#}");
     let model = v["families"]
         .as_array()
@@ -562,7 +562,7 @@ fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
         "{m:#}"
     );
     // the same loop with a healthy valve
-    let v = sp_json(&integrating_loop(dir.path(), "0"));
+    let v = judge(&integrating_loop(dir.path(), "0"));
     assert_ne!(v["verdict"], "stiction", "{v:#}");
 }
 
