@@ -171,7 +171,8 @@ fn record(d: &Diagnosis) {
         println!(
             "  oscillation: {}; period {}; regularity {:.2} (threshold {}); {} half periods with a large IAE",
             match (o.oscillating, o.across_setpoint_steps, o.weak_cycle) {
-                (true, true, _) => "yes, across the setpoint's steps (its holds are too short)",
+                (true, true, false) => "yes, across the setpoint's steps (its holds are too short)",
+                (true, true, true) => "yes, a weak cycle across the setpoint's steps (its holds are too short; its half periods clear 1.5 noise standard deviations, not 3, and its period wanders as a limit cycle's does beside noise)",
                 (true, false, true) => WEAK_CYCLE,
                 (true, false, false) => "yes",
                 _ => "no",

@@ -8,11 +8,17 @@ pub fn oscillation(d: &Diagnosis) -> Option<Vec<KvRow>> {
     Some(vec![
         kv(
             "Oscillating",
-            if o.oscillating && o.across_setpoint_steps {
+            if o.oscillating && o.weak_cycle {
+                format!(
+                    "yes: a weak cycle, regular and 1.5 to 3 noise standard deviations high; its period wanders as a limit cycle's does beside noise (one that kept a clock's time would be an input's){}",
+                    if o.across_setpoint_steps {
+                        "; across the setpoint's steps (no hold is long enough)"
+                    } else {
+                        ""
+                    }
+                )
+            } else if o.oscillating && o.across_setpoint_steps {
                 "yes: regular and above the noise, across the setpoint's steps (no hold is long enough)"
-                    .to_string()
-            } else if o.oscillating && o.weak_cycle {
-                "yes: a weak cycle, regular and 1.5 to 3 noise standard deviations high; its period wanders as a limit cycle's does beside noise (one that kept a clock's time would be an input's)"
                     .to_string()
             } else if o.oscillating {
                 "yes: regular and above the noise".to_string()
