@@ -4,8 +4,8 @@
 use crate::words::{count, seconds};
 use stiction_core::diagnose::{BandSource, Diagnosis, Verdict, Vote};
 
-/// The oscillation line's answer for a weak cycle (`Oscillation::weak_cycle`).
-const WEAK_CYCLE: &str = "yes, a weak cycle (its half periods clear 1.5 noise standard deviations, not 3, and its period wanders as a limit cycle's does beside noise)";
+/// Why a weak cycle (`Oscillation::weak_cycle`) counts, for the oscillation line.
+const WEAK_CYCLE: &str = "its half periods clear 1.5 noise standard deviations, not 3, and its period wanders as a limit cycle's does beside noise";
 
 fn band_source(s: BandSource) -> &'static str {
     match s {
@@ -171,11 +171,14 @@ fn record(d: &Diagnosis) {
         println!(
             "  oscillation: {}; period {}; regularity {:.2} (threshold {}); {} half periods with a large IAE",
             match (o.oscillating, o.across_setpoint_steps, o.weak_cycle) {
-                (true, true, false) => "yes, across the setpoint's steps (its holds are too short)",
-                (true, true, true) => "yes, a weak cycle across the setpoint's steps (its holds are too short; its half periods clear 1.5 noise standard deviations, not 3, and its period wanders as a limit cycle's does beside noise)",
-                (true, false, true) => WEAK_CYCLE,
-                (true, false, false) => "yes",
-                _ => "no",
+                (true, true, false) =>
+                    "yes, across the setpoint's steps (its holds are too short)".to_string(),
+                (true, true, true) => format!(
+                    "yes, a weak cycle across the setpoint's steps (its holds are too short; {WEAK_CYCLE})"
+                ),
+                (true, false, true) => format!("yes, a weak cycle ({WEAK_CYCLE})"),
+                (true, false, false) => "yes".to_string(),
+                _ => "no".to_string(),
             },
             o.period.map_or("-".into(), |p| format!("{p:.1} s")),
             o.regularity.regularity,
