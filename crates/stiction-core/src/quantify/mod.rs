@@ -92,11 +92,10 @@ pub fn quantify_checked(
     if !(req.model == ModelKind::Stenman && req.method == Method::Exact && pv.len() == n) {
         return quantify_inner(op, pv, req, None).map(|r| r.0);
     }
-    let staged = req.staged && n >= STAGE_FROM;
     let estimate_start = req.estimate_start && req.valve_start.is_none();
     // the first samples: at least a few oscillation periods (too short a start ranks the
     // cells by the transient)
-    let m = if n >= STAGE_FROM && (staged || estimate_start) {
+    let m = if n >= STAGE_FROM && (req.staged || estimate_start) {
         let period = crate::detect::regularity(pv, 1.0).period.unwrap_or(0.0);
         STAGE_SAMPLES
             .max((STAGE_PERIODS * period) as usize)
@@ -104,6 +103,8 @@ pub fn quantify_checked(
     } else {
         n
     };
+    // (a record that starts at rest gives its first samples no band to tell apart: walked whole)
+    let staged = req.staged && n >= STAGE_FROM && exact::stage_sees_the_travel(op, m);
     let mut req = req.clone();
     let mut extra = 0;
     let mut at_first_op = None;

@@ -2,7 +2,7 @@
 
 use crate::identify::{Data, Structure};
 use crate::models::ModelKind;
-use crate::quantify::exact::{exact_stenman, merged_top_cells};
+use crate::quantify::exact::{exact_stenman, merged_top_cells, stage_sees_the_travel};
 use crate::quantify::problem::{min_costs_1d, Hammerstein};
 
 /// A staged walk starts on this many samples, or this many oscillation periods of the PV if
@@ -137,7 +137,7 @@ pub(super) fn exact_band(
     let n = op.len();
     let whole = problems(op, data, structures, lag, x0);
     let mut walked = 0;
-    let outcomes = if n >= STAGE_FROM {
+    let outcomes = if n >= STAGE_FROM && stage_sees_the_travel(op, r.first_samples()) {
         let m = r.first_samples();
         let first = Data::new(&y[..m - lag], data.t0);
         let staged = problems(&op[..m], &first, structures, lag, x0);

@@ -64,12 +64,12 @@ fn a_lag_at_its_bound_is_also_compared_over_a_third_of_it() {
 
 #[test]
 fn a_limit_cycle_whose_fits_look_alike_is_compared_over_whole_periods() {
-    // fast-c-0035 of the catalogue's calibration set: a flow loop tuned at 0.97 of its ultimate
-    // gain, its Kano valve (S = 3.45 %, J = 1.57 %) limit-cycling every 20 s. Over a response
-    // time the fits with and without stiction look alike; over whole periods the cycle cancels,
-    // and the valve explains what is left far better than OP. (fast-c-0069, a loop of this kind
-    // too, is found over the response time since the fits' delay stops short of the lag.)
-    let d = judge_catalogue("fast-c-0035");
+    // fast-c-0043 of the catalogue's calibration set: a flow loop recorded every 5 s, its Kano
+    // valve (S = 0.76 %, J = 0.68 %) limit-cycling. Over a response time the fits with and
+    // without stiction look alike; over whole periods the cycle cancels, and the valve explains
+    // what is left far better than OP. (fast-c-0035, a loop of this kind too, is found over the
+    // response time since its first samples no longer choose the band's cells alone.)
+    let d = judge_catalogue("fast-c-0043");
     let model = model_family(&d);
     let c = model
         .model
@@ -279,4 +279,16 @@ fn op_steps_the_error_did_not_provoke_cast_no_stiction_vote() {
         assert_eq!(e.unprovoked_op_steps.unwrap().steps, 0, "{id}");
         assert!(!e.op_moved_elsewhere, "{id}");
     }
+}
+
+#[test]
+fn a_record_that_starts_at_rest_is_walked_whole() {
+    // routine-c-0003 of the catalogue's calibration set: a flow loop whose Stenman valve (4.5 %)
+    // holds for 620 s while a load ramp winds OP up, then slips and limit-cycles every 27 s. The
+    // first 600 samples, where a staged walk keeps its cells, see 3 % of OP's travel: every band
+    // keeps the valve still there, so the whole record is walked, and the valve is found.
+    let d = judge_catalogue("routine-c-0003");
+    let model = model_family(&d);
+    assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
 }

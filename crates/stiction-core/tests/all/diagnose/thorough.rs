@@ -4,13 +4,15 @@ use super::*;
 
 #[test]
 fn thorough_finds_a_valve_the_fit_of_changes_misses_and_reports_its_band() {
-    // routine-c-0003 of the catalogue's calibration set: a flow loop recorded every second, its
-    // Stenman valve d = 4.53 %; the fit of PV's changes settles on a small band near OP and no
-    // family decides. The levels test finds the valve and the band reported is its own.
-    let (_, d) = stiction_only_when_thorough("routine-c-0003");
+    // routine-c-0211 of the catalogue's calibration set: a pressure loop recorded every second,
+    // high noise, its He valve fs = 1.65 % (fd = 0.45 %); the fit of PV's changes finds no band
+    // a decision needs. The levels test finds the valve and the band reported is its own.
+    // (routine-c-0003, this test's loop before, is found without it since a record that starts
+    // at rest is walked whole.)
+    let (_, d) = stiction_only_when_thorough("routine-c-0211");
     let band = d.band.unwrap();
     assert_eq!(band.source, BandSource::Levels, "{band:?}");
-    assert!((band.band_percent_of_span - 4.53).abs() < 0.5, "{band:?}");
+    assert!((band.band_percent_of_span - 1.65).abs() < 0.3, "{band:?}");
     assert!(
         band.others
             .iter()
