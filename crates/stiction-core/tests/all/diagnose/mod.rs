@@ -6,7 +6,9 @@ mod record;
 mod shape;
 mod thorough;
 
-use stiction_core::diagnose::evidence::model::{CYCLE_CANCELLED_STICTION, FORCED_REGULARITY};
+use stiction_core::diagnose::evidence::model::{
+    CYCLE_CANCELLED_STICTION, FORCED_REGULARITY, SIGNIFICANCE_NONE, SIGNIFICANCE_STICTION,
+};
 use stiction_core::diagnose::evidence::stick_slip::PV_BAND_SIGMAS;
 use stiction_core::diagnose::{
     diagnose, BandSource, DiagnoseRequest, Family, LoopRecord, Verdict, Vote,

@@ -96,6 +96,25 @@ fn a_limit_cycle_whose_fits_look_alike_is_compared_over_whole_periods() {
 }
 
 #[test]
+fn a_limit_cycle_whose_fit_falls_short_of_a_vote_is_compared_over_whole_periods() {
+    // routine-x1-0017 (the first further draw of the routine suite): a flow loop recorded every
+    // second, its Stenman valve (d = 1.54 %) limit-cycling under high noise. Over a response time the band gains more than most healthy loops give, too
+    // little to decide; over whole periods the cycle cancels and the valve explains what is left.
+    let d = judge_catalogue("routine-x1-0017");
+    let model = model_family(&d);
+    let m = model.model.as_ref().unwrap();
+    assert!(
+        m.significance > SIGNIFICANCE_NONE && m.significance < SIGNIFICANCE_STICTION,
+        "{}",
+        model.note
+    );
+    let c = m.cycle_cancelled.clone().unwrap();
+    assert!(c.significance >= CYCLE_CANCELLED_STICTION, "{c:?}");
+    assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+}
+
+#[test]
 fn the_stiction_fit_is_also_polished_from_the_linear_loops_dynamics() {
     // fast-c-0024 of the catalogue's calibration set: a flow loop at 0.90 of its ultimate gain
     // with a Stenman valve (d = 0.88 %), not cycling. The stiction fit's own output-error search

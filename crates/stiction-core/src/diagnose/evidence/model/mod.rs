@@ -190,7 +190,7 @@ pub struct ModelEvidence {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub levels: Option<LevelsEvidence>,
     /// The fits compared over whole periods of the cycle, when the loop limit-cycles and the
-    /// first comparison finds the fits alike, or to check a stiction vote on a cycle that keeps
+    /// first comparison falls short of a stiction vote, or to check a stiction vote on a cycle that keeps
     /// time like an input of fixed period ([`CycleCancelled`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle_cancelled: Option<CycleCancelled>,
@@ -265,8 +265,9 @@ impl EvidenceFamily for Model {
             "improvement of the fit with stiction over the linear loop, share of the PV's variance above its noise";
         let threshold = format!(
             "stiction when the improvement, held against the stiction fit's residual per independent change, reaches {SIGNIFICANCE_STICTION} \
-             (about the 95th percentile of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more: then the same test on \
-             changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}) or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
+             (about the 95th percentile of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); on a loop that limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more) and stays under it, the same test on \
+             changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}; none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles \
+             or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
              of the PV's variation above its noise; no stiction vote on a loop that does not limit-cycle when the fitted process and the identified PI \
              make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller); PV's changes are compared over 1.5 response times, \
              at most a tenth of the record, and where the lag reaches that bound also over a third of it (the higher ratio kept)",
@@ -297,10 +298,11 @@ impl EvidenceFamily for Model {
         let fits = fits_words(ctx, f, &evidence);
         let (mut vote, mut strength, mut why) = vote(ctx, f, &levels);
         if vote == Vote::Undetermined
-            && levels.significance <= SIGNIFICANCE_NONE
+            && levels.significance < SIGNIFICANCE_STICTION
             && limit_cycles(ctx)
         {
-            // the fits look alike on a limit cycle: compare them over whole periods
+            // the fits look alike, or too alike for a vote, on a limit cycle: compare them over
+            // whole periods
             evidence.cycle_cancelled = CycleCancelled::of(ctx, f);
             if let Some(c) = &evidence.cycle_cancelled {
                 why = format!("{why}; {}", c.words());
