@@ -69,19 +69,8 @@ fn a_limit_cycle_whose_fits_look_alike_is_compared_over_whole_periods() {
     // without stiction look alike; over whole periods the cycle cancels, and the valve explains
     // what is left far better than OP. (fast-c-0035, a loop of this kind too, is found over the
     // response time since its first samples no longer choose the band's cells alone.)
-    let d = judge_catalogue("fast-c-0043");
-    let model = model_family(&d);
-    let c = model
-        .model
-        .as_ref()
-        .unwrap()
-        .cycle_cancelled
-        .clone()
-        .unwrap();
-    assert!(c.significance >= CYCLE_CANCELLED_STICTION, "{c:?}");
-    assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
+    let model = found_over_whole_periods("fast-c-0043");
     assert!(model.note.contains("whole period"), "{}", model.note);
-    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
     // healthy valves: a loop at its stability limit (fast-c-0151, 0.97 of the ultimate gain) and
     // an external sinusoid (fast-c-0126) reach the same comparison, and the valve explains nothing
     for id in ["fast-c-0151", "fast-c-0126"] {
@@ -98,20 +87,29 @@ fn a_limit_cycle_whose_fits_look_alike_is_compared_over_whole_periods() {
 #[test]
 fn a_limit_cycle_whose_fit_falls_short_of_a_vote_is_compared_over_whole_periods() {
     // routine-x1-0017 (the first further draw of the routine suite): a flow loop recorded every
-    // second, its Stenman valve (d = 1.54 %) limit-cycling under high noise. Over a response time the band gains more than most healthy loops give, too
-    // little to decide; over whole periods the cycle cancels and the valve explains what is left.
-    let d = judge_catalogue("routine-x1-0017");
-    let model = model_family(&d);
+    // second, its Stenman valve (d = 1.54 %) limit-cycling under high noise. Over a response
+    // time the band gains more than most healthy loops give, too little to decide; over whole
+    // periods the cycle cancels and the valve explains what is left.
+    let model = found_over_whole_periods("routine-x1-0017");
     let m = model.model.as_ref().unwrap();
     assert!(
         m.significance > SIGNIFICANCE_NONE && m.significance < SIGNIFICANCE_STICTION,
         "{}",
         model.note
     );
-    let c = m.cycle_cancelled.clone().unwrap();
-    assert!(c.significance >= CYCLE_CANCELLED_STICTION, "{c:?}");
-    assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
-    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+}
+
+/// The model family's evidence on a catalogue loop it finds sticky by comparing the fits over
+/// whole periods of the cycle, and the verdict `stiction`.
+fn found_over_whole_periods(id: &str) -> stiction_core::diagnose::evidence::FamilyEvidence {
+    let d = judge_catalogue(id);
+    let model = model_family(&d).clone();
+    let c = model.model.as_ref().and_then(|m| m.cycle_cancelled.clone());
+    let c = c.unwrap_or_else(|| panic!("{id}: {}", model.note));
+    assert!(c.significance >= CYCLE_CANCELLED_STICTION, "{id}: {c:?}");
+    assert_eq!(model.vote, Vote::Stiction, "{id}: {}", model.note);
+    assert_eq!(d.verdict, Verdict::Stiction, "{id}: {:?}", d.evidence);
+    model
 }
 
 #[test]
