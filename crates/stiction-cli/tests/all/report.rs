@@ -98,6 +98,17 @@ fn report_of_a_sticky_loop_is_self_contained() {
     assert!(html.contains("optimal set"));
     assert!(html.contains("estimated MV"));
     assert!(html.contains("PV simulated"));
+    // the phase plot's band in the verdict's units
+    let label = html
+        .split("Stenman d = ")
+        .nth(1)
+        .expect("the phase plot names the fitted model");
+    assert!(label.starts_with(char::is_numeric), "{}", &label[..40]);
+    assert!(
+        label.split(',').next().unwrap().ends_with(" % of span"),
+        "{}",
+        &label[..40]
+    );
     assert!(html.contains("Distinct valve trajectories (cells)"));
     assert!(html.contains("proven over every distinct valve trajectory"));
     assert!(html.contains("each cell of the whole record lies inside"));

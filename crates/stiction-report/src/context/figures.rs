@@ -187,6 +187,18 @@ pub(super) fn zoom(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -
     })
 }
 
+/// A band in OP units in % of valve span, as the verdict's band maps OP (its ratio of % of span
+/// to OP units); in OP units where the verdict gives no band to map it by.
+fn band_words(d: &Diagnosis, op_units: f64) -> String {
+    match &d.band {
+        Some(b) if b.op_units > 0.0 => format!(
+            "{} % of span",
+            num(op_units * b.band_percent_of_span / b.op_units)
+        ),
+        _ => format!("{} in OP units", num(op_units)),
+    }
+}
+
 pub(super) fn phase(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) -> Result<Figure> {
     let [s, e] = d.quantified.unwrap_or(d.analysed);
     let (s, e) = if s + 1 < e && e <= data.op.len() {
@@ -199,24 +211,22 @@ pub(super) fn phase(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) 
     let sim = q
         .filter(|q| q.pv_simulated.len() == e - s)
         .map(|q| (op.clone(), series::thin(&q.pv_simulated, PHASE_POINTS)));
+    // the fitted model and its band name the simulated trace (a title that long is cut on a
+    // phone's width)
+    let fitted = match q.and_then(|q| q.apparent_stiction.map(|b| (q, b))) {
+        Some((q, b)) => format!(
+            "{} d = {}, simulated",
+            capital(&q.model.to_string()),
+            band_words(d, b)
+        ),
+        None => "fitted model, simulated".into(),
+    };
     let mut traces = vec![plots::line("measured", &measured, 5)];
     if let Some(sim) = &sim {
-        traces.push(plots::line("fitted model, simulated", sim, 1));
+        traces.push(plots::line(&fitted, sim, 1));
     }
-    let title = match q.and_then(|q| q.apparent_stiction.map(|b| (q, b))) {
-        Some((q, b)) if sim.is_some() => format!(
-            "PV against OP, with the fitted {} model (d = {})",
-            capital(&q.model.to_string()),
-            num(b)
-        ),
-        _ => "PV against OP".into(),
-    };
-    let chart = plots::chart(
-        &title,
-        "controller output OP",
-        "process variable PV",
-        traces,
-    );
+    let title = "PV against OP";
+    let chart = plots::chart(title, "controller output OP", "process variable PV", traces);
     let caption = if sim.is_some() {
         "The measured PV against OP (grey) over the analysed stretch, and the PV the fitted model \
          simulates (red). While a sticky valve holds, OP moves and PV does not follow: the plot draws \
