@@ -93,6 +93,9 @@ fn report_of_a_sticky_loop_is_self_contained() {
     assert!(html.contains("Stiction band"));
     assert!(html.contains("Closed-loop fit with and without stiction"));
     assert!(html.contains("<th>Family</th>"), "the families of evidence");
+    // on a phone each row of a wide table is a card, each cell named by its column
+    assert!(html.contains("<td class=\"text\" data-label=\"Why\">"));
+    assert!(html.contains("table.wide td::before { content: attr(data-label)"));
     assert!(html.contains("% of valve span</strong>"));
     assert!(html.contains("Valve position at the first sample"));
     assert!(html.contains("optimal set"));
