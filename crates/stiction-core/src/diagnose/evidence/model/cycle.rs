@@ -7,16 +7,16 @@
 //! its responses to the setpoint and the loads, and the cycle's changes from one period to the
 //! next. A valve that sticks shapes those as it shapes the cycle, and a linear loop does not; a
 //! linear loop at its stability limit or an external input at the cycle's period leaves nothing
-//! there a band explains. The same calibrated test then decides, held to twice the first
-//! comparison's threshold ([`CYCLE_CANCELLED_STICTION`]): a second look at the same record must
-//! clear a higher bar.
+//! there a band explains. The same calibrated test then decides, at the first comparison's
+//! threshold ([`CYCLE_CANCELLED_STICTION`]).
 //!
 //! On the catalogue's calibration set (other seeds than the benchmark's) 62 healthy loops reach
 //! this comparison; their test ratios stay under 50 (the highest 48 and 11); the sticky loops that
-//! reach it give up to 1,238. At the threshold 2 more of the 90 sticky fast loops are called sticky
-//! and no look-alike (at 50: also 1 more of the 240 sticky routine loops, at 99). On the benchmark
-//! set, 2 more sticky routine and 2 more sticky fast loops, no look-alike (one externally
-//! oscillating routine loop reaches 70, but OP explains only 29 % of what is left).
+//! reach it give up to 1,238. The threshold was first held to twice the first comparison's (100:
+//! a second look at the same record clearing a higher bar); there 2 more of the 90 sticky fast
+//! loops were called sticky and no look-alike. On the benchmark set, 2 more sticky routine and 2
+//! more sticky fast loops, no look-alike (one externally oscillating routine loop reaches 70, but
+//! OP explains only 29 % of what is left).
 //!
 //! It first ran only where the first comparison found the fits alike (test ratio 15 and below);
 //! it now runs wherever a limit cycle's first ratio stays under the stiction threshold, for a
@@ -24,6 +24,16 @@
 //! further draws of both suites (2,340 loops), 20 more healthy loops reach it (their ratios under
 //! 48), 90 more sticky loops, and 2 more sticky loops are called sticky, with no false alarm;
 //! over four more draws (4 to 7), 1 more sticky loop and no false alarm.
+//!
+//! Over all those draws the healthy loops that reach it stay under 50 on the calibration set and
+//! the first three further draws (341 loops, the highest 48); on draws 4 to 7 (291 loops) one
+//! externally oscillating loop reaches 63 (already called sticky on other evidence). So the bar
+//! came down to the first comparison's, 50: over the calibration sets and three further draws, 13
+//! more sticky valves called `stiction` (7 routine, 6 fast) and no false alarm; over draws 4 to 7,
+//! 13 more (10 routine, 3 fast) and no false alarm; on the benchmark sets (checked after), one
+//! more sticky routine and one more sticky fast loop, no look-alike (the externally oscillating
+//! routine loop that reaches 52 there has too little of what is left explained by OP), and the
+//! ISDB and the 108 loops unchanged.
 
 use super::{Levels, MIN_EXPLAINED, SIGNIFICANCE_NONE, SIGNIFICANCE_STICTION};
 use crate::diagnose::evidence::Context;
@@ -31,7 +41,7 @@ use crate::quantify::{compare_fits, CompareRequest, FitComparison};
 use serde::{Deserialize, Serialize};
 
 /// The test's ratio at and above which the comparison over whole periods votes stiction.
-pub const CYCLE_CANCELLED_STICTION: f64 = 2.0 * SIGNIFICANCE_STICTION;
+pub const CYCLE_CANCELLED_STICTION: f64 = SIGNIFICANCE_STICTION;
 
 /// A cycle at least this regular (Thornhill's r: its period's standard deviation under a 300th
 /// of the period) keeps time like an input of fixed period, or like a limit cycle the noise

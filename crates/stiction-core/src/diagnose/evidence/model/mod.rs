@@ -309,7 +309,7 @@ impl EvidenceFamily for Model {
                 if c.sticky() {
                     // its ratio on the first test's scale: half strength at its own threshold
                     let s = test_strength(
-                        c.significance / CYCLE_CANCELLED_STICTION * SIGNIFICANCE_STICTION,
+                        c.significance * SIGNIFICANCE_STICTION / CYCLE_CANCELLED_STICTION,
                     );
                     (vote, strength) = (Vote::Stiction, s);
                 }
