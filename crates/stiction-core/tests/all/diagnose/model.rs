@@ -117,6 +117,19 @@ fn the_comparison_over_whole_periods_votes_at_the_first_comparisons_threshold() 
     assert_eq!(CYCLE_CANCELLED_STICTION, SIGNIFICANCE_STICTION);
 }
 
+#[test]
+fn an_oscillation_whose_period_wanders_is_compared_over_whole_periods_too() {
+    // fast-x1-0010 (the first further draw of the fast suite): a pressure loop whose Stenman
+    // valve (d = 1.43 %) cycles with a wandering period (regularity under 5: no limit cycle).
+    // Over a response time the band gains nothing; over whole periods it explains what is left.
+    let d = judge_catalogue("fast-x1-0010");
+    let o = d.oscillation.as_ref().unwrap();
+    assert!(o.oscillating && o.regularity.regularity < 5.0, "{o:?}");
+    let model = found_over_whole_periods("fast-x1-0010");
+    let m = model.model.as_ref().unwrap();
+    assert!(m.significance <= SIGNIFICANCE_NONE, "{}", model.note);
+}
+
 /// The model family's evidence on a catalogue loop it finds sticky by comparing the fits over
 /// whole periods of the cycle, and the verdict `stiction`.
 fn found_over_whole_periods(id: &str) -> stiction_core::diagnose::evidence::FamilyEvidence {

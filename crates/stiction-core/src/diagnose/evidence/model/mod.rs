@@ -83,6 +83,20 @@ fn limit_cycles(ctx: &Context) -> bool {
     let o = &ctx.oscillation;
     o.oscillating && o.regularity.regularity >= LIMIT_CYCLE_REGULARITY
 }
+/// Whether the fits are compared again over whole periods of the cycle ([`CycleCancelled`]),
+/// where the first comparison decided nothing or no more than that the band gains what healthy
+/// loops gain: on a limit cycle whose first test ratio stays under the stiction threshold (the
+/// fits look alike there whatever the cause), and on any other oscillating loop whose fits the
+/// first comparison found alike while OP explains the PV (a cycle whose period wanders is fitted
+/// by linear dynamics from OP as a regular one is; a vote against stiction that the variation
+/// enters elsewhere stands).
+fn second_look(ctx: &Context, vote: Vote, levels: &Levels) -> bool {
+    match vote {
+        Vote::Undetermined => levels.significance < SIGNIFICANCE_STICTION && limit_cycles(ctx),
+        Vote::NoStiction => levels.explained >= MIN_EXPLAINED && ctx.oscillation.oscillating,
+        Vote::Stiction => false,
+    }
+}
 /// A regular cycle of a few samples a period (its period, s, and samples per period), which the
 /// fits cannot resolve.
 fn unresolved(ctx: &Context) -> Option<(f64, f64)> {
@@ -265,7 +279,7 @@ impl EvidenceFamily for Model {
             "improvement of the fit with stiction over the linear loop, share of the PV's variance above its noise";
         let threshold = format!(
             "stiction when the improvement, held against the stiction fit's residual per independent change, reaches {SIGNIFICANCE_STICTION} \
-             (about the 95th percentile of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); on a loop that limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more) and stays under it, the same test on \
+             (about the 95th percentile of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); on a loop that limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more) and stays under it, or on another oscillating loop where it finds none, the same test on \
              changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}; none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles \
              or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
              of the PV's variation above its noise; no stiction vote on a loop that does not limit-cycle when the fitted process and the identified PI \
@@ -297,12 +311,7 @@ impl EvidenceFamily for Model {
         evidence.levels = test.evidence().cloned();
         let fits = fits_words(ctx, f, &evidence);
         let (mut vote, mut strength, mut why) = vote(ctx, f, &levels);
-        if vote == Vote::Undetermined
-            && levels.significance < SIGNIFICANCE_STICTION
-            && limit_cycles(ctx)
-        {
-            // the fits look alike, or too alike for a vote, on a limit cycle: compare them over
-            // whole periods
+        if second_look(ctx, vote, &levels) {
             evidence.cycle_cancelled = CycleCancelled::of(ctx, f);
             if let Some(c) = &evidence.cycle_cancelled {
                 why = format!("{why}; {}", c.words());
