@@ -1,4 +1,4 @@
-//! The model family's second look at a limit cycle: the fits compared over whole periods.
+//! The model family's second look at a cycle: the fits compared over whole periods.
 //!
 //! A regular cycle is a few harmonics, and linear dynamics from OP fit it about as well as the
 //! sticky valve that causes it: compared over about a response time, the fits with and without
@@ -10,42 +10,16 @@
 //! there a band explains. The same calibrated test then decides, at the first comparison's
 //! threshold ([`CYCLE_CANCELLED_STICTION`]).
 //!
-//! On the catalogue's calibration set (other seeds than the benchmark's) 62 healthy loops reach
-//! this comparison; their test ratios stay under 50 (the highest 48 and 11); the sticky loops that
-//! reach it give up to 1,238. The threshold was first held to twice the first comparison's (100:
-//! a second look at the same record clearing a higher bar); there 2 more of the 90 sticky fast
-//! loops were called sticky and no look-alike. On the benchmark set, 2 more sticky routine and 2
-//! more sticky fast loops, no look-alike (one externally oscillating routine loop reaches 70, but
-//! OP explains only 29 % of what is left).
-//!
-//! It first ran only where the first comparison found the fits alike (test ratio 15 and below);
-//! it now runs wherever a limit cycle's first ratio stays under the stiction threshold, for a
-//! ratio between the two says as little on a regular cycle. Over the calibration sets and three
-//! further draws of both suites (2,340 loops), 20 more healthy loops reach it (their ratios under
-//! 48), 90 more sticky loops, and 2 more sticky loops are called sticky, with no false alarm;
-//! over four more draws (4 to 7), 1 more sticky loop and no false alarm.
-//!
-//! Over all those draws the healthy loops that reach it stay under 50 on the calibration set and
-//! the first three further draws (341 loops, the highest 48); on draws 4 to 7 (291 loops) one
-//! externally oscillating loop reaches 63 (already called sticky on other evidence). So the bar
-//! came down to the first comparison's, 50: over the calibration sets and three further draws, 13
-//! more sticky valves called `stiction` (7 routine, 6 fast) and no false alarm; over draws 4 to 7,
-//! 13 more (10 routine, 3 fast) and no false alarm; on the benchmark sets (checked after), one
-//! more sticky routine and one more sticky fast loop, no look-alike (the externally oscillating
-//! routine loop that reaches 52 there has too little of what is left explained by OP), and the
-//! ISDB and the 108 loops unchanged.
-//!
-//! Then it also runs on an oscillating loop that is no limit cycle (regularity under 5, its
-//! period wandering) where the first comparison finds the fits alike (no more than healthy loops
-//! gain) while OP explains the PV: linear dynamics from OP fit such a cycle as they fit a regular
-//! one, and over whole periods of its mean period most of it still cancels. Over the calibration
-//! sets and three further draws: 7 more sticky valves called `stiction` (1 routine, 6 fast), one
-//! from `no_stiction` to `undetermined`, no false alarm, the healthy loops that reach the
-//! comparison still under 48; over draws 4 to 7, 7 more (4 routine, 3 fast), no false alarm;
-//! over all ten calibration draws 17 more and one false alarm (a narrow-band load at the loop's
-//! period, regularity 1.5; from a regularity of 2: 10 more, none); on the benchmark sets one more
-//! sticky routine window, no look-alike; the ISDB and the 108 loops unchanged; the batch's CPU
-//! time on its mix unchanged (1.00x, 200 loops, one thread).
+//! It runs where the first comparison falls short of a stiction vote on a cycle: on a limit cycle
+//! whose first test ratio stays under the stiction threshold, and on any other oscillating loop
+//! (its period wandering) whose fits the first comparison finds alike while OP explains the PV
+//! (`second_look` in the family). The threshold is calibrated on the healthy loops that reach it:
+//! on the catalogue's calibration set and its first three further draws (other seeds than the
+//! benchmark's), 341 of them with test ratios under 50 (the highest 48), where the sticky loops
+//! that reach it give up to 1,238; over all ten calibration draws one healthy loop more votes
+//! (a narrow-band load at the loop's period, regularity 1.5, ratio 71). What each step of it
+//! moved, on the calibration draws and then the benchmark, is in `docs/accuracy-history.md`: it
+//! first ran only on limit cycles whose fits looked alike and voted from a ratio of 100.
 
 use super::{Levels, MIN_EXPLAINED, SIGNIFICANCE_NONE, SIGNIFICANCE_STICTION};
 use crate::diagnose::evidence::Context;

@@ -203,9 +203,9 @@ pub struct ModelEvidence {
     /// The levels test, when the request is `thorough` and it ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub levels: Option<LevelsEvidence>,
-    /// The fits compared over whole periods of the cycle, when the loop limit-cycles and the
-    /// first comparison falls short of a stiction vote, or to check a stiction vote on a cycle that keeps
-    /// time like an input of fixed period ([`CycleCancelled`]).
+    /// The fits compared over whole periods of the cycle, where the loop oscillates and the
+    /// first comparison falls short of a stiction vote (`second_look`), or to check a stiction
+    /// vote on a cycle that keeps time like an input of fixed period ([`CycleCancelled`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle_cancelled: Option<CycleCancelled>,
     /// The stiction vote was withdrawn: the band's gain lay in a cycle that keeps time like an
