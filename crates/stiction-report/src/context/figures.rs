@@ -225,8 +225,12 @@ pub(super) fn phase(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) 
     if let Some(sim) = &sim {
         traces.push(plots::line(&fitted, sim, 1));
     }
-    let title = "PV against OP";
-    let chart = plots::chart(title, "controller output OP", "process variable PV", traces);
+    let chart = plots::chart(
+        "PV against OP",
+        "controller output OP",
+        "process variable PV",
+        traces,
+    );
     let caption = if sim.is_some() {
         "The measured PV against OP (grey) over the analysed stretch, and the PV the fitted model \
          simulates (red). While a sticky valve holds, OP moves and PV does not follow: the plot draws \
