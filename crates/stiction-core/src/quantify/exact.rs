@@ -4,7 +4,7 @@
 //! their number. Without `full`, only the chunks around the best points of a coarse scan are walked
 //! (faster, exact only there).
 
-use super::problem::Hammerstein;
+use super::problem::{Hammerstein, OverLag};
 use super::search::Outcome;
 use crate::estimate::{exact, IntervalKind};
 use crate::identify;
@@ -160,7 +160,7 @@ impl Walk {
             rows,
         } = self;
         let n = seen.len();
-        let (offset, lag) = (problems[0].offset, problems[0].lag);
+        let (offset, lag, over) = (problems[0].offset, problems[0].lag, problems[0].over);
         let mut out = Vec::new();
         let mut bounds = start_bounds.to_vec();
         let mut sums: Vec<identify::ValveSums> = Vec::new();
@@ -168,11 +168,13 @@ impl Walk {
         let prepared: Vec<&identify::Prepared> = problems.iter().map(|p| &p.prepared).collect();
         exact::stenman_walk_changes(problems[0].op, x0, chunk, range, |cell, full, moved| {
             changed.clear();
+            // a sum over the lag changes on a whole lag's samples for each move: seen afresh
+            let moved = moved.filter(|_| over == OverLag::Change);
             match moved {
-                None => seen_whole(full, offset, lag, seen),
+                None => seen_whole(full, offset, lag, over, seen),
                 Some(moved) => seen_changes(full, moved, offset, lag, seen, prev, changed),
             }
-            let refresh = sums.is_empty() || out.len() % FULL_EVERY == 0;
+            let refresh = sums.is_empty() || out.len() % FULL_EVERY == 0 || moved.is_none();
             if !refresh && changed.len() < n / 8 {
                 for (p, s) in problems.iter().zip(sums.iter_mut()) {
                     p.prepared.update_sums(s, prev, seen, changed, rows);
@@ -198,14 +200,14 @@ impl Walk {
 }
 
 /// The trajectory as the linear part sees it (`seen`): the valve position less the offset, or
-/// its changes over the lag.
-fn seen_whole(full: &[f64], offset: f64, lag: usize, seen: &mut [f64]) {
+/// over the lag as `over` says.
+fn seen_whole(full: &[f64], offset: f64, lag: usize, over: OverLag, seen: &mut [f64]) {
     if lag == 0 {
         for (s, &v) in seen.iter_mut().zip(full) {
             *s = v - offset;
         }
     } else {
-        super::problem::difference(full, lag, seen);
+        super::problem::over_lag(full, lag, over, offset, seen);
     }
 }
 
@@ -337,7 +339,7 @@ fn outcome(
 
 #[cfg(test)]
 mod tests {
-    use super::{seen_changes, seen_whole, stage_sees_the_travel};
+    use super::{seen_changes, seen_whole, stage_sees_the_travel, OverLag};
 
     /// A record whose OP moves evenly is staged; one at rest on its first samples, then moving,
     /// is walked whole; one that moves most at its start is staged.
@@ -358,7 +360,7 @@ mod tests {
 
     fn seen_of(full: &[f64], offset: f64, lag: usize) -> Vec<f64> {
         let mut seen = vec![0.0; full.len() - lag];
-        seen_whole(full, offset, lag, &mut seen);
+        seen_whole(full, offset, lag, OverLag::Change, &mut seen);
         seen
     }
 

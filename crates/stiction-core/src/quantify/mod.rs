@@ -34,6 +34,7 @@ pub use compare::{
     compare_fits, correlation_span, max_lag, off_the_pv_cycle, CompareRequest, FitComparison,
     ModelFit,
 };
+pub use problem::OverLag;
 pub use request::QuantifyRequest;
 pub use result::{
     FitOutput, FitQuality, LinearFamily, LinearModel, Quantification, QuantifyStatus,

@@ -91,6 +91,11 @@ pub struct Settings<'a> {
     pub unrecorded: &'a [bool],
     /// The PV a valve that follows OP would give (the identified linear loop), if known.
     pub pv_linear: Option<&'a [f64]>,
+    /// An integrating process's rate, the judged signal's change per sample per OP unit: a
+    /// level starts to move when the valve does and keeps moving, so what a valve that followed
+    /// OP would have moved it by over an episode is read from OP's travel from the episode's
+    /// start through the rate (which needs no load model), not from `pv_linear`.
+    pub rate: Option<f64>,
     /// The process gain in units of the judged signal per OP unit; `None` when unknown.
     pub gain: Option<f64>,
     /// Process dead time, samples.
@@ -203,14 +208,26 @@ fn judge(
     if j - i <= s.dead_samples + 1 {
         return Episode::Slow;
     }
-    if let Some(lin) = s.pv_linear {
-        let moved = lin[i..j]
-            .iter()
-            .map(|v| (v - lin[i]).abs())
-            .fold(0.0, f64::max);
-        if moved < 2.0 * band {
-            return Episode::Slow;
-        }
+    let followed = match (s.rate, s.pv_linear) {
+        (Some(rate), _) => Some(
+            op_s[i..j]
+                .iter()
+                .scan(0.0, |level, v| {
+                    *level += rate * (v - op_s[i]);
+                    Some(level.abs())
+                })
+                .fold(0.0, f64::max),
+        ),
+        (None, Some(lin)) => Some(
+            lin[i..j]
+                .iter()
+                .map(|v| (v - lin[i]).abs())
+                .fold(0.0, f64::max),
+        ),
+        (None, None) => None,
+    };
+    if followed.is_some_and(|moved| moved < 2.0 * band) {
+        return Episode::Slow;
     }
     // the slip: within the process's response time PV leaves the band the way OP pushed it, by
     // a good share of what the OP travel gives through the process gain (a loop that holds PV
@@ -313,14 +330,26 @@ impl EvidenceFamily for StickSlip {
             100.0 * DECISIVE_SHARE
         );
         let ts = ctx.req.ts;
-        let (pv_linear, gain, dead_samples, response_samples) = match &ctx.fits {
+        let found = |g: Option<f64>| g.filter(|g| g.is_finite() && *g != 0.0);
+        let (pv_linear, rate, gain, dead_samples, response_samples) = match &ctx.fits {
+            // a level (its fit's gain a rate per second): what a valve step moves it by over the
+            // lag the fits compare (1.5 response times, at least a 25th of the record), a window
+            // the slip's move must show within
+            Some(f) if f.structure.integrating => (
+                None,
+                found(f.gain).map(|k| k * ts),
+                found(f.gain).map(|k| k * f.lag as f64 * ts),
+                (f.dead_time / ts).round() as usize,
+                f.lag,
+            ),
             Some(f) => (
                 (!f.pv_linear.is_empty()).then_some(f.pv_linear.as_slice()),
-                f.gain.filter(|g| g.is_finite() && *g != 0.0),
+                None,
+                found(f.gain),
                 (f.dead_time / ts).round() as usize,
                 ((f.dead_time + 2.0 * f.time_constant.unwrap_or(0.0)) / ts).round() as usize + 1,
             ),
-            None => (None, None, 0, 3),
+            None => (None, None, None, 0, 3),
         };
         // Every loop is judged on PV itself, levels too: a stuck level valve leaves the level
         // still where the flows nearly balance. Judging a level's smoothed rate instead (which a
@@ -333,6 +362,7 @@ impl EvidenceFamily for StickSlip {
             pv_quantum: ctx.pv_quantum,
             unrecorded: &ctx.unrecorded,
             pv_linear,
+            rate,
             gain,
             dead_samples,
             response_samples,
@@ -381,6 +411,7 @@ mod tests {
             pv_quantum: None,
             unrecorded,
             pv_linear: None,
+            rate: None,
             gain: Some(1.0),
             dead_samples: 2,
             response_samples: 3,

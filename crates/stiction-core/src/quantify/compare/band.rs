@@ -3,7 +3,7 @@
 use crate::identify::{Data, Structure};
 use crate::models::ModelKind;
 use crate::quantify::exact::{exact_stenman, merged_top_cells, stage_sees_the_travel};
-use crate::quantify::problem::{min_costs_1d, Hammerstein};
+use crate::quantify::problem::{min_costs_1d, Hammerstein, OverLag};
 
 /// A staged walk starts on this many samples, or this many oscillation periods of the PV if
 /// more, up to half the record, when the record has at least `STAGE_FROM` samples.
@@ -25,23 +25,26 @@ const START_GAIN: f64 = 0.7;
 const START_GRID: usize = 32;
 
 /// The record the band is walked on: OP, the PV's changes over the lag (`y`, from sample `t0`
-/// on) and the period of their cycle (0 without one), measured once for every stage.
+/// on), what the linear part sees of the valve over the lag, and the period of the changes'
+/// cycle (0 without one), measured once for every stage.
 pub(super) struct Record<'a> {
     pub op: &'a [f64],
     pub y: &'a [f64],
     pub t0: usize,
     pub lag: usize,
+    pub over: OverLag,
     pub period: f64,
 }
 
 impl<'a> Record<'a> {
-    pub fn new(op: &'a [f64], y: &'a [f64], t0: usize, lag: usize) -> Self {
+    pub fn new(op: &'a [f64], y: &'a [f64], t0: usize, lag: usize, over: OverLag) -> Self {
         let period = crate::detect::regularity(y, 1.0).period.unwrap_or(0.0);
         Self {
             op,
             y,
             t0,
             lag,
+            over,
             period,
         }
     }
@@ -63,12 +66,12 @@ fn problems<'a>(
     op: &'a [f64],
     data: &'a Data<'a>,
     structures: &[Structure],
-    lag: usize,
+    (lag, over): (usize, OverLag),
     x0: f64,
 ) -> Vec<Hammerstein<'a>> {
     structures
         .iter()
-        .map(|&s| Hammerstein::new(ModelKind::Stenman, op, data, s, Some(x0)).with_lag(lag))
+        .map(|&s| Hammerstein::new(ModelKind::Stenman, op, data, s, Some(x0)).with_lag(lag, over))
         .collect()
 }
 
@@ -101,7 +104,7 @@ pub(super) fn valve_start(r: &Record, structures: &[Structure], op_range: f64) -
         .collect();
     for f in START_SHARES {
         let x0 = op[0] + f * span;
-        let ps = problems(op_m, &data, structures, lag, x0);
+        let ps = problems(op_m, &data, structures, (lag, r.over), x0);
         let cost = min_costs_1d(&ps, &grid)
             .into_iter()
             .fold(f64::INFINITY, f64::min);
@@ -135,12 +138,12 @@ pub(super) fn exact_band(
 ) -> (Vec<(f64, Structure)>, u64) {
     let Record { op, y, lag, .. } = *r;
     let n = op.len();
-    let whole = problems(op, data, structures, lag, x0);
+    let whole = problems(op, data, structures, (lag, r.over), x0);
     let mut walked = 0;
     let outcomes = if n >= STAGE_FROM && stage_sees_the_travel(op, r.first_samples()) {
         let m = r.first_samples();
         let first = Data::new(&y[..m - lag], data.t0);
-        let staged = problems(&op[..m], &first, structures, lag, x0);
+        let staged = problems(&op[..m], &first, structures, (lag, r.over), x0);
         let stage = exact_stenman(&staged, (0.0, op_range), true, None);
         walked += stage.iter().map(|o| o.evaluations).max().unwrap_or(0);
         let merged = merged_top_cells(stage.iter());

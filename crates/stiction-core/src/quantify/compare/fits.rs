@@ -4,7 +4,7 @@ use super::{dependence, CompareRequest, FitComparison, ModelFit, Setup};
 use crate::detect::measurement_noise;
 use crate::identify::{self, Data, Fit};
 use crate::models::Model;
-use crate::quantify::problem::difference;
+use crate::quantify::problem::{over_lag, OverLag};
 
 /// The compared fits, before they are put in words and R².
 pub(super) struct Fits {
@@ -29,13 +29,14 @@ impl Fits {
     ) -> FitComparison {
         let fit_s = self.stiction_fit;
         let sst = fit_s.sst;
-        let phys = identify::physical(&fit_s, req.ts);
+        let stiction_model = per_sample(&fit_s, setup);
+        let linear_model = self.linear.as_ref().map(|f| per_sample(f, setup));
+        let phys = identify::physical(&stiction_model, req.ts);
         let levels = Data::new(pv, setup.t0);
         let mv_stiction = self.stiction.simulate_from(op, Some(self.x0));
         let mv_centred: Vec<f64> = mv_stiction.iter().map(|v| v - setup.offset).collect();
-        let pv_stiction = identify::simulate_pv(&levels, &mv_centred, &fit_s);
-        let pv_linear = self
-            .linear
+        let pv_stiction = identify::simulate_pv(&levels, &mv_centred, &stiction_model);
+        let pv_linear = linear_model
             .as_ref()
             .map(|f| identify::simulate_pv(&levels, &setup.op_centred, f))
             .unwrap_or_default();
@@ -50,7 +51,7 @@ impl Fits {
         let compared = Data::new(&setup.y, setup.t0);
         let mv_compared = {
             let mut mv = vec![0.0; op.len() - setup.lag];
-            difference(&mv_stiction, setup.lag, &mut mv);
+            over_lag(&mv_stiction, setup.lag, setup.over, setup.offset, &mut mv);
             mv
         };
         let correlation_span = dependence::correlation_span(
@@ -63,7 +64,8 @@ impl Fits {
         );
         FitComparison {
             correlation_span,
-            structure: fit_s.structure,
+            structure: stiction_model.structure,
+            over_lag: setup.over,
             lag: setup.lag,
             samples_used: self.samples_used,
             sst,
@@ -91,10 +93,30 @@ impl Fits {
             pv_linear,
             pv_stiction,
             mv_stiction,
-            linear_model: self.linear,
-            stiction_model: Some(fit_s),
+            linear_model,
+            stiction_model: Some(stiction_model),
             op_offset: setup.offset,
         }
+    }
+}
+
+/// A fit of the compared changes as the model of the PV it implies: as it is for the valve's
+/// change over the lag (the same dynamics), and for its sum over the lag the integrating
+/// structure of the PV's change per sample, one sample more delay (`A(q)(q^L - 1) pv =
+/// B(q) q^-nk (q^L - 1) q^-1 / (1 - q^-1) x`, so `A(q) (1 - q^-1) pv = B(q) q^-(nk+1) x`), its
+/// constant a sample's share of the lag's.
+fn per_sample(f: &Fit, setup: &Setup) -> Fit {
+    match setup.over {
+        OverLag::Change => f.clone(),
+        OverLag::Sum => Fit {
+            structure: identify::Structure {
+                integrating: true,
+                nk: f.structure.nk + 1,
+                ..f.structure
+            },
+            c: f.c / setup.lag as f64,
+            ..f.clone()
+        },
     }
 }
 

@@ -27,7 +27,7 @@ mod setup;
 pub use dependence::correlation_span;
 pub use lag::off_the_pv_cycle;
 
-use super::problem::{difference, range};
+use super::problem::{over_lag, range, OverLag};
 use crate::identify::{self, Data, Fit, SearchRange, Structure};
 use crate::models::{Kano, Model, Stenman};
 use band::{exact_band, valve_start, Record};
@@ -77,8 +77,13 @@ pub struct ModelFit {
 /// The fits with and without stiction on one record.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitComparison {
-    /// The linear structure the stiction fits use.
+    /// The linear structure the stiction fits use, as a model of the PV (see
+    /// [`FitComparison::stiction_model`]).
     pub structure: Structure,
+    /// What the fits see of the valve over the lag: its change, or for an integrating process
+    /// its sum (the level's inflow).
+    #[serde(default)]
+    pub over_lag: OverLag,
     /// The lag (samples) of the changes compared: `pv[t + lag] - pv[t]`.
     pub lag: usize,
     /// Samples the sums run over.
@@ -115,8 +120,9 @@ pub struct FitComparison {
     #[serde(skip)]
     pub mv_stiction: Vec<f64>,
     /// The linear loop's fitted model (a valve that follows OP) and the best stiction model's
-    /// linear part: ARX coefficients of the compared (differenced) output, the same dynamics as
-    /// the PV's.
+    /// linear part, as models of the PV: ARX coefficients of the compared (differenced) output,
+    /// the same dynamics as the PV's, or for the valve summed over the lag the integrating
+    /// structure they imply.
     #[serde(skip)]
     pub linear_model: Option<Fit>,
     /// The best stiction model's linear part, as `linear_model`.
@@ -168,6 +174,8 @@ pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitC
         op,
         data: &data,
         lag: setup.lag,
+        over: setup.over,
+        offset: setup.offset,
         start: None,
     };
     let mut evaluations = 3;
@@ -185,7 +193,7 @@ pub fn compare_fits(op: &[f64], pv: &[f64], req: &CompareRequest) -> Option<FitC
             evaluations += 1;
         }
     }
-    let record = Record::new(op, &setup.y, setup.t0, setup.lag);
+    let record = Record::new(op, &setup.y, setup.t0, setup.lag, setup.over);
     let (x0, walked) = valve_start(&record, &structures, op_range);
     evaluations += walked;
     let problem = Problem {
@@ -382,15 +390,18 @@ struct Problem<'a> {
     op: &'a [f64],
     data: &'a Data<'a>,
     lag: usize,
+    over: OverLag,
+    /// Subtracted from each valve position a sum over the lag adds (the mean OP).
+    offset: f64,
     start: Option<f64>,
 }
 
 impl Problem<'_> {
-    /// A valve trajectory differenced over the lag.
+    /// A valve trajectory over the lag (see [`OverLag`]).
     fn valve(&self, m: &Model) -> Vec<f64> {
         let full = m.simulate_from(self.op, self.start);
         let mut mv = vec![0.0; self.op.len() - self.lag];
-        difference(&full, self.lag, &mut mv);
+        over_lag(&full, self.lag, self.over, self.offset, &mut mv);
         mv
     }
 
@@ -405,7 +416,7 @@ impl Problem<'_> {
                 || (vec![0.0; n], vec![0.0; n - self.lag]),
                 |(full, mv), m| {
                     m.simulate_from_into(self.op, self.start, full);
-                    difference(full, self.lag, mv);
+                    over_lag(full, self.lag, self.over, self.offset, mv);
                     prepared
                         .fit(mv)
                         .filter(Fit::stable)

@@ -5,7 +5,7 @@
 use super::lag::{detrended, half_correlation, off_the_cycle_of};
 use super::{CompareRequest, CYCLE_REGULARITY, INTEGRATING_LAG_SHARE, LAG_RESPONSES, MIN_LAG};
 use crate::identify::{self, Data, SearchRange, Structure};
-use crate::quantify::problem::difference;
+use crate::quantify::problem::{difference, over_lag, OverLag};
 
 /// The compared output and the search every fit shares.
 pub(super) struct Setup {
@@ -15,11 +15,14 @@ pub(super) struct Setup {
     /// The mean OP, taken from the valve position before fitting levels.
     pub(super) offset: f64,
     pub(super) op_centred: Vec<f64>,
-    /// PV's changes over the lag, and OP's.
+    /// PV's changes over the lag, and OP as the linear part sees it over the lag.
     pub(super) y: Vec<f64>,
     pub(super) linear_mv: Vec<f64>,
     /// Where the PV limit-cycles: the search stopped short of the lag, tried beside the whole one.
     pub(super) short_search: Option<SearchRange>,
+    /// What the linear part sees of the valve over the lag: its change, or for an integrating
+    /// process its sum (the level's inflow).
+    pub(super) over: OverLag,
 }
 
 impl Setup {
@@ -59,7 +62,15 @@ impl Setup {
         }
         // changes over the lag are bounded even for an integrating process (over the lag its
         // level changes by the sum of its inflow): compared with self-regulating structures,
-        // whose simulation errors are those of the PV's changes, not of its noisy rate
+        // whose simulation errors are those of the PV's changes, not of its noisy rate, against
+        // the valve summed over the lag ([`OverLag::Sum`]), with structures without output lags
+        // as well
+        let over = if req.integrating == Some(true) || first.integrating {
+            search.na = vec![0, 1, 2];
+            OverLag::Sum
+        } else {
+            OverLag::Change
+        };
         search.integrating = false;
         search.self_regulating = true;
         // the valve's changes should stop short of the sample where PV's change starts. OP's
@@ -87,7 +98,7 @@ impl Setup {
         let mut y = vec![0.0; n - lag];
         difference(pv, lag, &mut y);
         let mut linear_mv = vec![0.0; n - lag];
-        difference(op, lag, &mut linear_mv);
+        over_lag(op, lag, over, offset, &mut linear_mv);
         Some(Self {
             search,
             t0,
@@ -97,6 +108,7 @@ impl Setup {
             y,
             linear_mv,
             short_search,
+            over,
         })
     }
 }

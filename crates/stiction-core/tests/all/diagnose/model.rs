@@ -297,11 +297,12 @@ fn a_fit_that_mirrors_the_controller_casts_no_stiction_vote() {
 
 #[test]
 fn op_steps_the_error_did_not_provoke_cast_no_stiction_vote() {
-    // routine-c-0518 of the plant catalogue (calibration set): a healthy level valve whose
+    // routine-c-0514 of the plant catalogue (calibration set): a healthy flow valve whose
     // controller feeds a measured load's steps forward to OP; OP jumps while PV, the load
-    // compensated, stays at its setpoint, and the closed-loop fit explained that by a valve that
-    // sticks through the jumps (test ratio 69): it was called `stiction`
-    let d = judged_with_the_fit_withdrawn("routine-c-0518");
+    // compensated, stays at its setpoint, and the closed-loop fit explains that by a valve that
+    // sticks through the jumps (a level of the same class, routine-c-0518, was called `stiction`
+    // so at a test ratio of 69 before its fits saw the valve's inflow)
+    let d = judged_with_the_fit_withdrawn("routine-c-0514");
     let m = model_family(&d);
     let e = m.model.as_ref().unwrap();
     assert!(e.op_moved_elsewhere);
@@ -338,5 +339,30 @@ fn a_record_that_starts_at_rest_is_walked_whole() {
     let d = judge_catalogue("routine-c-0003");
     let model = model_family(&d);
     assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+}
+
+#[test]
+fn a_levels_changes_are_fitted_to_the_valves_inflow() {
+    // routine-c-0014 of the catalogue's calibration set: a level (integration rate 0.00424 per s)
+    // whose Stenman valve (3.72 %) slips 154 times in 2,000 samples at 1 s, with setpoint steps
+    // and high noise. Its changes over the lag against the valve's changes need an output lag at
+    // the unit circle, whose least-squares fits simulate at random: the walk chose 4.9 % and the
+    // stiction fit fell below the linear loop's (`no_stiction`). Against the valve's position
+    // summed over the lag (the level's inflow), the walk finds the band and the rate.
+    let d = judge_catalogue("routine-c-0014");
+    let model = model_family(&d);
+    let m = model.model.as_ref().expect("the fits' figures");
+    assert_eq!(m.over_lag, stiction_core::quantify::OverLag::Sum);
+    assert!(m.structure.integrating, "{:?}", m.structure);
+    let rate = m.gain.expect("an integration rate");
+    assert!((rate / 0.00424 - 1.0).abs() < 0.1, "rate {rate}");
+    assert!(
+        (m.stenman_d / 3.72 - 1.0).abs() < 0.1,
+        "band {}",
+        m.stenman_d
+    );
+    assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
+    assert!(model.note.contains("its inflow"), "{}", model.note);
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
 }

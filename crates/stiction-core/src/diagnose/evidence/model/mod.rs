@@ -44,7 +44,7 @@ use withdraw::{loop_gain, withdrawn};
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
 use crate::diagnose::result::Vote;
 use crate::identify::Structure;
-use crate::quantify::FitComparison;
+use crate::quantify::{FitComparison, OverLag};
 use levels::LevelsTest;
 use serde::{Deserialize, Serialize};
 
@@ -137,8 +137,12 @@ than the benchmark's), not on the data judged";
 /// The fits behind the model family's vote.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModelEvidence {
-    /// The linear structure the fits share.
+    /// The linear structure the fits share, as a model of the PV (integrating for a level).
     pub structure: Structure,
+    /// What the fits see of the valve over the lag: its change, or for an integrating process
+    /// its position summed over the lag (the level's inflow).
+    #[serde(default)]
+    pub over_lag: OverLag,
     /// R² in simulation of the output (PV, or its change for an integrating structure).
     pub r2_without_stiction: f64,
     /// R² in simulation of the output with Stenman's valve.
@@ -408,7 +412,24 @@ fn fits_words(ctx: &Context, f: &FitComparison, evidence: &ModelEvidence) -> Str
             "; PV's changes compared over {} samples, a third of the bound of {b} the lag reached (the stronger of the two comparisons)",
             f.lag
         )
-    })
+    }) + &inflow_words(f)
+}
+
+/// For a level, a clause saying how the fits see it: its changes over the lag against the
+/// valve's position summed over them, and the integration rate found.
+fn inflow_words(f: &FitComparison) -> String {
+    match (f.over_lag, f.gain) {
+        (OverLag::Sum, Some(k)) => format!(
+            "; a level: its changes over {} samples fitted to the valve's position summed over them (its inflow), \
+             integration rate {k:.3e} per s per OP unit",
+            f.lag
+        ),
+        (OverLag::Sum, None) => format!(
+            "; a level: its changes over {} samples fitted to the valve's position summed over them (its inflow)",
+            f.lag
+        ),
+        (OverLag::Change, _) => String::new(),
+    }
 }
 
 /// The fits' figures, as the result reports them.
@@ -422,6 +443,7 @@ fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) -> ModelEvi
     let d = f.stenman.params[0];
     ModelEvidence {
         structure: f.structure,
+        over_lag: f.over_lag,
         r2_without_stiction: f.linear.r2,
         r2_stenman: f.stenman.r2,
         r2_slip_jump: f.slip_jump.r2,
