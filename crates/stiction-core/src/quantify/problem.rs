@@ -252,3 +252,28 @@ impl CostFunction for Hammerstein<'_> {
             );
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{over_lag, OverLag};
+
+    /// The valve summed over the lag, by its running sum (summed afresh every 256 samples),
+    /// equals each window summed directly; its change over the lag is the difference.
+    #[test]
+    fn the_valve_over_a_lag_is_its_change_or_its_window_sum() {
+        let x: Vec<f64> = (0..900)
+            .map(|i| 50.0 + 10.0 * ((i * 37 % 101) as f64 / 101.0) + (i as f64 * 0.01).sin())
+            .collect();
+        for lag in [1, 7, 80, 300] {
+            let mut sum = vec![0.0; x.len() - lag];
+            over_lag(&x, lag, OverLag::Sum, 50.0, &mut sum);
+            let mut change = vec![0.0; x.len() - lag];
+            over_lag(&x, lag, OverLag::Change, 50.0, &mut change);
+            for t in 0..x.len() - lag {
+                let direct: f64 = x[t..t + lag].iter().map(|v| v - 50.0).sum();
+                assert!((sum[t] - direct).abs() < 1e-9, "lag {lag}, t {t}");
+                assert_eq!(change[t], x[t + lag] - x[t]);
+            }
+        }
+    }
+}
