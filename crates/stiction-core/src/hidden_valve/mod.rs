@@ -9,7 +9,7 @@
 //! valve). Against it, a Kalman filter with the valve following OP and the same unrecorded moves
 //! of OP as input noise. Both share one loop model ([`LoopModel`]): valve lag, first-order process
 //! or integrator, dead time, a drifting and a cycling load, measurement noise; its parameters are
-//! found by coordinate ascent on each hypothesis's likelihood ([`test`]), and the healthy one is
+//! found by coordinate ascent on each hypothesis's likelihood ([`fn@test`]), and the healthy one is
 //! searched again from the sticky one's optimum, so the ratio is never an artefact of a search
 //! that stopped short.
 //!

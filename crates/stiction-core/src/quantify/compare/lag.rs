@@ -16,7 +16,7 @@ fn off_the_cycle(lag: usize, pv: &[f64], max_lag: usize) -> usize {
 }
 
 /// A lag chosen elsewhere, moved off the PV's regular cycle as the comparison's own lag is
-/// ([`off_the_cycle`]; `pv` as recorded, at most [`super::max_lag`]).
+/// (`off_the_cycle`; `pv` as recorded, at most [`super::max_lag`]).
 pub fn off_the_pv_cycle(lag: usize, pv: &[f64]) -> usize {
     let max_lag = super::max_lag(pv.len());
     let reg = crate::detect::regularity(&detrended(pv), 1.0);

@@ -9,7 +9,9 @@
 //! valve moves. Fitted on levels, even the true valve position then explains PV worse than OP
 //! does. So both fits compare *changes over a lag* of about the process's response time,
 //! `pv[t + L] - pv[t]` against the valve's `mv[t + L] - mv[t]`: the linear part is the same, and
-//! drifts slower than the lag fall away.
+//! drifts slower than the lag fall away. A level's change over the lag is its inflow, so for an
+//! integrating process the valve is summed over the lag instead ([`OverLag::Sum`]), and the fits'
+//! models of the PV are the integrating structures that implies.
 //!
 //! The stages: the lag (from a first linear fit), where the valve stood at the first sample (a
 //! Stenman valve started elsewhere stays out of step with the real one for good: candidates are
@@ -152,7 +154,7 @@ pub(super) const LAG_RESPONSES: f64 = 1.5;
 const MIN_LAG: usize = 2;
 const MAX_LAG_SHARE: usize = 10;
 
-/// The longest lag of the changes compared on a record of `n` samples ([`MAX_LAG_SHARE`]).
+/// The longest lag of the changes compared on a record of `n` samples (`MAX_LAG_SHARE`, a tenth).
 pub fn max_lag(n: usize) -> usize {
     (n / MAX_LAG_SHARE).max(MIN_LAG)
 }

@@ -37,7 +37,7 @@ pub const CYCLE_CANCELLED_STICTION: f64 = SIGNIFICANCE_STICTION;
 /// fitted about as well by linear dynamics from OP (issue 14's example: 0.1 %). So when the
 /// family votes stiction on such a cycle with a gain of at least [`FORCED_GAIN`], the fits are
 /// compared over whole periods too; if the band gains there no more than healthy loops give
-/// ([`CycleCancelled::only_the_cycle`]), its gain was the cycle's alone and the vote is withdrawn
+/// (`CycleCancelled::only_the_cycle`), its gain was the cycle's alone and the vote is withdrawn
 /// (the family then leans towards stiction). On the catalogue's calibration set, of the 72 sticky
 /// loops that limit-cycle and on which the family votes stiction, 7 gain nothing over whole
 /// periods, at regularities of 7 to 56; the externally oscillating loop that does the same, 125

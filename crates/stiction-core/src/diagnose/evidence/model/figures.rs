@@ -87,19 +87,19 @@ pub struct ModelEvidence {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle_cancelled: Option<CycleCancelled>,
     /// The stiction vote was withdrawn: the band's gain lay in a cycle that keeps time like an
-    /// input of fixed period, and over whole periods it gained nothing ([`FORCED_REGULARITY`]).
+    /// input of fixed period, and over whole periods it gained nothing ([`super::FORCED_REGULARITY`]).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub gain_in_a_clock_regular_cycle: bool,
     /// The stiction vote was withdrawn: the fitted process and the identified PI make a loop
-    /// gain under [`MIN_LOOP_GAIN`], so the fit explains PV through the controller's own law.
+    /// gain under [`super::MIN_LOOP_GAIN`], so the fit explains PV through the controller's own law.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub fit_mirrors_controller: bool,
     /// The stiction vote was withdrawn: OP steps that the control error did not provoke carry
-    /// [`MAX_UNPROVOKED_SHARE`] or more of OP's travel (a feed-forward, an override, an operator).
+    /// [`super::MAX_UNPROVOKED_SHARE`] or more of OP's travel (a feed-forward, an override, an operator).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub op_moved_elsewhere: bool,
     /// The lag's bound (samples), when the lag reached it and the comparison over a third of it
-    /// ([`BOUND_LAG_DIVISOR`]), which `lag` then gives, had the higher test ratio.
+    /// ([`super::BOUND_LAG_DIVISOR`]), which `lag` then gives, had the higher test ratio.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lag_bound: Option<usize>,
 }

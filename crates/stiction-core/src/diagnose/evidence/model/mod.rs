@@ -109,7 +109,7 @@ const ELSEWHERE_STRENGTH: f64 = 0.9;
 /// Below this share explained the variation plainly enters elsewhere; from it up to
 /// [`MIN_EXPLAINED`] a sticky valve that seldom moves in a window driven by its load leaves as
 /// little (levels and temperatures above all), and the vote is weak
-/// ([`ELSEWHERE_WEAK_STRENGTH`]). On the catalogue's calibration sets (routine and fast) 20 of the
+/// (`ELSEWHERE_WEAK_STRENGTH`). On the catalogue's calibration sets (routine and fast) 20 of the
 /// 21 loops under 0.15 have a healthy valve, 10 of the 17 between 0.15 and 0.3.
 pub const ELSEWHERE_CLEAR: f64 = 0.15;
 /// Strength of the vote against stiction when OP explains between [`ELSEWHERE_CLEAR`] and

@@ -28,7 +28,7 @@ pub const OP_TRAVEL_SIGMAS: f64 = 4.0;
 /// Strength of a stiction vote: below what a verdict needs on its own (see the verdict).
 const STICTION_STRENGTH: f64 = 0.4;
 /// From this many episodes holding at least [`DECISIVE_SHARE`] of the OP's travel the vote is
-/// held with [`DECISIVE_STRENGTH`], enough to decide alone. On the catalogue's calibration set and
+/// held with `DECISIVE_STRENGTH`, enough to decide alone. On the catalogue's calibration set and
 /// nine more draws of it (3,600 not-sticky loops, 3,300 sticky ones, 300 backlash valves), no
 /// not-sticky loop with 20 episodes or more spends more than 66 % of the OP's travel in them (the
 /// highest: an equal-percentage valve, 66 %, a saturating OP, 64 %, an external oscillation,
