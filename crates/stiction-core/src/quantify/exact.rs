@@ -127,6 +127,8 @@ struct Walk {
     /// problems are), and the previous cell's.
     mv: Vec<f64>,
     prev: Vec<f64>,
+    /// The previous cell's whole trajectory (for sums over the lag, updated where it moved).
+    prev_full: Vec<f64>,
     changed: Vec<usize>,
     rows: Vec<usize>,
 }
@@ -137,6 +139,7 @@ impl Walk {
         Self {
             mv: vec![0.0; n],
             prev: vec![0.0; n],
+            prev_full: Vec::new(),
             changed: Vec::new(),
             rows: Vec::new(),
         }
@@ -156,6 +159,7 @@ impl Walk {
         let Walk {
             mv: seen,
             prev,
+            prev_full,
             changed,
             rows,
         } = self;
@@ -168,13 +172,28 @@ impl Walk {
         let prepared: Vec<&identify::Prepared> = problems.iter().map(|p| &p.prepared).collect();
         exact::stenman_walk_changes(problems[0].op, x0, chunk, range, |cell, full, moved| {
             changed.clear();
-            // a sum over the lag changes on a whole lag's samples for each move: seen afresh
-            let moved = moved.filter(|_| over == OverLag::Change);
-            match moved {
-                None => seen_whole(full, offset, lag, over, seen),
-                Some(moved) => seen_changes(full, moved, offset, lag, seen, prev, changed),
+            let due = sums.is_empty() || out.len() % FULL_EVERY == 0;
+            // sums over the lag are updated by each move's change, so now and then summed afresh
+            let moved = moved.filter(|_| !(due && over == OverLag::Sum));
+            match (moved, over) {
+                (None, _) => seen_whole(full, offset, lag, over, seen),
+                (Some(moved), OverLag::Change) => {
+                    seen_changes(full, moved, offset, lag, seen, prev, changed)
+                }
+                (Some(moved), OverLag::Sum) => {
+                    sums_changes(full, prev_full, moved, lag, seen, prev, changed)
+                }
             }
-            let refresh = sums.is_empty() || out.len() % FULL_EVERY == 0 || moved.is_none();
+            if over == OverLag::Sum {
+                match moved {
+                    None => {
+                        prev_full.clear();
+                        prev_full.extend_from_slice(full);
+                    }
+                    Some(moved) => moved.iter().for_each(|&i| prev_full[i] = full[i]),
+                }
+            }
+            let refresh = due || moved.is_none();
             if !refresh && changed.len() < n / 8 {
                 for (p, s) in problems.iter().zip(sums.iter_mut()) {
                     p.prepared.update_sums(s, prev, seen, changed, rows);
@@ -249,6 +268,43 @@ fn seen_changes(
             changed.push(t);
         }
     }
+}
+
+/// The valve summed over the lag (`seen`), updated where the valve moved (`moved`, samples of
+/// the whole trajectory `full`, `prev_full` the previous one): a move at sample `i` changes the
+/// sums of the windows that hold it, `i - lag + 1 ..= i`; the samples of `seen` that now differ
+/// from `prev` bit for bit, in increasing order, into `changed`.
+fn sums_changes(
+    full: &[f64],
+    prev_full: &[f64],
+    moved: &[usize],
+    lag: usize,
+    seen: &mut [f64],
+    prev: &[f64],
+    changed: &mut Vec<usize>,
+) {
+    let n = seen.len();
+    let mut reach = 0;
+    for &i in moved {
+        let delta = full[i] - prev_full[i];
+        if delta == 0.0 {
+            continue;
+        }
+        let first = (i + 1).saturating_sub(lag);
+        let last = i.min(n.saturating_sub(1));
+        if first > last || first >= n {
+            continue;
+        }
+        for s in &mut seen[first..=last] {
+            *s += delta;
+        }
+        // the windows of the moves come in increasing order: each sample named once
+        for t in first.max(reach)..=last {
+            changed.push(t);
+        }
+        reach = reach.max(last + 1);
+    }
+    changed.retain(|&t| seen[t].to_bits() != prev[t].to_bits());
 }
 
 /// Ranges of d in increasing order of their starts, with those that touch or overlap joined.
@@ -339,7 +395,7 @@ fn outcome(
 
 #[cfg(test)]
 mod tests {
-    use super::{seen_changes, seen_whole, stage_sees_the_travel, OverLag};
+    use super::{seen_changes, seen_whole, stage_sees_the_travel, sums_changes, OverLag};
 
     /// A record whose OP moves evenly is staged; one at rest on its first samples, then moving,
     /// is walked whole; one that moves most at its start is staged.
@@ -395,6 +451,44 @@ mod tests {
                     .filter(|&t| whole[t].to_bits() != prev[t].to_bits())
                     .collect();
                 assert_eq!(changed, truth, "lag {lag}, moved {moved:?}");
+            }
+        }
+    }
+
+    /// Updated where the valve moved, the valve summed over the lag equals the sums taken whole
+    /// (to rounding), and the samples named are those that differ from before, in increasing
+    /// order.
+    #[test]
+    fn sums_over_the_lag_follow_the_valves_moves() {
+        let n = 60;
+        let old: Vec<f64> = (0..n).map(|i| ((i * 7) % 11) as f64).collect();
+        let moves: [&[usize]; 4] = [&[0], &[n - 1], &[3, 4, 5, 6, 20, 21], &[0, 1, 58, 59]];
+        for lag in [1, 3, 12] {
+            for moved in moves {
+                let mut new = old.clone();
+                for &i in moved {
+                    new[i] += 1.5;
+                }
+                let whole = |x: &[f64]| {
+                    let mut seen = vec![0.0; n - lag];
+                    seen_whole(x, 2.0, lag, OverLag::Sum, &mut seen);
+                    seen
+                };
+                let prev = whole(&old);
+                let mut seen = prev.clone();
+                let mut changed = Vec::new();
+                sums_changes(&new, &old, moved, lag, &mut seen, &prev, &mut changed);
+                let truth = whole(&new);
+                for t in 0..seen.len() {
+                    assert!(
+                        (seen[t] - truth[t]).abs() < 1e-12,
+                        "lag {lag}, moved {moved:?}"
+                    );
+                }
+                let differ: Vec<usize> = (0..truth.len())
+                    .filter(|&t| (truth[t] - prev[t]).abs() > 1e-12)
+                    .collect();
+                assert_eq!(changed, differ, "lag {lag}, moved {moved:?}");
             }
         }
     }
