@@ -123,8 +123,8 @@ fn around_best(chunks: &[(f64, f64)], scan_costs: &[Vec<f64>]) -> Vec<(f64, f64)
 
 /// One thread's buffers for walking chunks of the d-partition.
 struct Walk {
-    /// The valve trajectory as the linear part sees it (less the offset, or differenced when the
-    /// problems are), and the previous cell's.
+    /// The valve trajectory as the linear part sees it (less the offset, or over the lag when the
+    /// problems compare changes), and the previous cell's.
     mv: Vec<f64>,
     prev: Vec<f64>,
     /// The previous cell's whole trajectory (for sums over the lag, updated where it moved).
@@ -193,7 +193,8 @@ impl Walk {
                     Some(moved) => moved.iter().for_each(|&i| prev_full[i] = full[i]),
                 }
             }
-            let refresh = due || moved.is_none();
+            // (a cell seen whole is always due: the first, or a sum over the lag summed afresh)
+            let refresh = due;
             if !refresh && changed.len() < n / 8 {
                 for (p, s) in problems.iter().zip(sums.iter_mut()) {
                     p.prepared.update_sums(s, prev, seen, changed, rows);
