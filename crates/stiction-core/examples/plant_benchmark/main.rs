@@ -29,6 +29,7 @@ mod breakdown;
 #[path = "../common/catalogue_loop.rs"]
 mod catalogue_loop;
 mod confidence;
+mod detectability;
 mod spread;
 mod tables;
 use tables::{
@@ -286,6 +287,7 @@ fn run_suite(o: &Options, suite: Suite, md: &mut String, jsonl: &mut String) {
         );
     }
     sticky_table(md, &loops, &res);
+    detectability::detectability_table(md, &groups);
     band::band_table(md, &groups);
     confidence::confidence_table(md, &groups);
     breakdown::breakdown_tables(md, &groups);
