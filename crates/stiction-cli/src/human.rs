@@ -26,6 +26,9 @@ pub fn print_diagnosis(file: &str, d: &Diagnosis) {
     headline(file, d);
     fits(d);
     println!("  next step: {}", d.next_step);
+    if let Some(r) = d.reach.as_ref().filter(|_| d.verdict != Verdict::Stiction) {
+        println!("  what this record can show: {}", r.words());
+    }
     evidence(d);
     record(d);
     for w in &d.warnings {

@@ -85,6 +85,33 @@ pub fn measurement_noise(x: &[f64]) -> f64 {
     }
 }
 
+/// A held signal repeats its value in at least this share of its samples (a controller slower
+/// than the record, or a historian that stores a value only when it changes).
+pub const HELD_SHARE: f64 = 0.3;
+
+/// The noise of a signal that may be held between updates (OP recorded faster than the
+/// controller runs): [`measurement_noise`], except that where at least [`HELD_SHARE`] of the
+/// first differences are exactly zero it is taken from the changes between the held values alone
+/// (a held signal's median change is zero, which would call it noise-free).
+pub fn held_noise(x: &[f64]) -> f64 {
+    let steps = x.len().saturating_sub(1);
+    let held = x.windows(2).filter(|w| w[1] == w[0]).count();
+    if steps == 0 || (held as f64) < HELD_SHARE * steps as f64 {
+        return measurement_noise(x);
+    }
+    let mut changes: Vec<f64> = x
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .filter(|d| *d > 0.0 && d.is_finite())
+        .collect();
+    if changes.is_empty() {
+        return 0.0;
+    }
+    let mid = changes.len() / 2;
+    let (_, median, _) = changes.select_nth_unstable_by(mid, f64::total_cmp);
+    *median / 0.6745 / 2f64.sqrt()
+}
+
 /// Autocorrelation of a mean-free copy of `x` for lags `0..=max_lag` (biased estimator, so r(0) = 1;
 /// all zeros for a constant). Computed by FFT.
 pub fn autocorrelation(x: &[f64], max_lag: usize) -> Vec<f64> {
@@ -452,6 +479,25 @@ mod tests {
                 (std::f64::consts::TAU * k as f64 * ts / period).sin() + noise * gaussian(&mut rng)
             })
             .collect()
+    }
+
+    #[test]
+    fn a_signal_held_between_updates_has_the_noise_of_its_changes() {
+        // OP of a controller that runs every other sample: white noise on a slow ramp, each
+        // value recorded twice
+        let mut rng = seeded(11);
+        let updates: Vec<f64> = (0..1500)
+            .map(|k| 40.0 + 0.001 * k as f64 + 0.1 * gaussian(&mut rng))
+            .collect();
+        let held: Vec<f64> = updates.iter().flat_map(|&v| [v, v]).collect();
+        // half the changes are zero: the robust estimate calls the signal noise-free
+        assert_eq!(measurement_noise(&held), 0.0);
+        // from the changes between the held values: the updates' own noise
+        let sd = held_noise(&held);
+        assert!((sd - 0.1).abs() < 0.01, "held noise {sd}");
+        // a signal that is not held keeps the usual estimate
+        assert_eq!(held_noise(&updates), measurement_noise(&updates));
+        assert_eq!(held_noise(&[1.0; 10]), 0.0);
     }
 
     #[test]

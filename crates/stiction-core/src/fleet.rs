@@ -84,6 +84,11 @@ pub struct Row {
     pub band_source: Option<BandSource>,
     /// The width of the ellipse fitted to an oscillation's PV-OP plot, % of valve span.
     pub ellipse_percent_of_span: Option<f64>,
+    /// A small band for this record, % of valve span (4 of OP's noise standard deviations: a
+    /// sticky valve with a band under it was found in 12-41 % of simulated records; see
+    /// [`crate::diagnose::Reach`]): what a `no_stiction` row is nearly silent on.
+    #[serde(default)]
+    pub small_band_percent_of_span: Option<f64>,
     /// Oscillation period, seconds.
     pub period_s: Option<f64>,
     /// Thornhill's regularity of the oscillation; `None` when there is no oscillation analysis.
@@ -155,6 +160,7 @@ impl Row {
             band_percent_of_span: d.band.as_ref().map(|b| b.band_percent_of_span),
             band_source: d.band.as_ref().map(|b| b.source),
             ellipse_percent_of_span: d.band.as_ref().and_then(|b| b.ellipse_percent_of_span),
+            small_band_percent_of_span: d.reach.as_ref().map(|r| r.small_band_percent_of_span),
             period_s: d.oscillation.as_ref().and_then(|o| o.period),
             regularity: d.oscillation.as_ref().map(|o| o.regularity.regularity),
             reason: d.reason.clone().unwrap_or_else(|| votes(d)),
@@ -176,6 +182,7 @@ impl Row {
             band_percent_of_span: None,
             band_source: None,
             ellipse_percent_of_span: None,
+            small_band_percent_of_span: None,
             period_s: None,
             regularity: None,
             reason: error.clone(),

@@ -103,7 +103,7 @@ fn text(s: &str) -> Cow<'_, str> {
     }
 }
 
-pub const CSV_HEADER: [&str; 16] = [
+pub const CSV_HEADER: [&str; 17] = [
     "loop_id",
     "source",
     "verdict",
@@ -112,6 +112,7 @@ pub const CSV_HEADER: [&str; 16] = [
     "band_percent_of_span",
     "band_source",
     "ellipse_percent_of_span",
+    "small_band_percent_of_span",
     "period_s",
     "regularity",
     "same_period_loops",
@@ -147,6 +148,7 @@ fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
                 &cell(f.band_percent_of_span),
                 f.band_source.map_or("", |s| s.as_str()),
                 &cell(f.ellipse_percent_of_span),
+                &cell(f.small_band_percent_of_span),
                 &cell(f.period_s),
                 &cell(f.regularity),
                 &r.same_period_loops.to_string(),

@@ -94,6 +94,22 @@ fn a_healthy_loop_with_noise_only_is_no_stiction() {
     let v = json(&ok(&["diagnose", &f, "--sp", "sp", "--json"]));
     assert_eq!(v["verdict"], "no_stiction", "{v:#}");
     assert!(v.get("quantification").is_none());
+    // what the verdict speaks for: the bands the record hides, from OP's noise
+    let reach = &v["reach"];
+    let sd = reach["op_noise_percent_of_span"].as_f64().unwrap();
+    assert!(sd > 0.0, "{reach:#}");
+    let small = reach["small_band_percent_of_span"].as_f64().unwrap();
+    let large = reach["large_band_percent_of_span"].as_f64().unwrap();
+    assert!((small - 4.0 * sd).abs() < 1e-9 && (large - 12.0 * sd).abs() < 1e-9);
+    let human = ok(&["diagnose", &f, "--sp", "sp"]);
+    let line = human
+        .lines()
+        .find(|l| l.trim_start().starts_with("what this record can show:"))
+        .unwrap_or_else(|| panic!("no reach line in:\n{human}"));
+    assert!(
+        line.contains(&format!("under {small:.2} % of span")),
+        "{line}"
+    );
 }
 
 #[test]

@@ -1,7 +1,8 @@
 //! What a record lets the families see of a sticky valve: the sticky loops called stiction by
-//! their band over the OP's noise. Proportional action passes the PV's measurement noise on to
-//! OP (Kc times its standard deviation); a band of a few such standard deviations is crossed by
-//! the noise alone, and the valve then moves in small jumps a healthy valve's noise looks like.
+//! their band over the OP's noise as the diagnosis measured it (`Diagnosis::reach`).
+//! Proportional action passes the PV's measurement noise on to OP; a band of a few such standard
+//! deviations is crossed by the noise alone, and the valve then moves in small jumps a healthy
+//! valve's noise looks like. The table on the calibration draws set `diagnose::reach`'s figures.
 
 use super::tables::{pct, Groups};
 use std::fmt::Write as _;
@@ -9,17 +10,18 @@ use stiction_core::diagnose::Verdict;
 use stiction_core::sim::catalogue::Truth;
 
 /// Upper edges of the rows (band over the OP's noise standard deviation).
-const EDGES: [(f64, &str); 6] = [
-    (3.0, "under 3"),
-    (6.0, "3 to 6"),
-    (12.0, "6 to 12"),
+const EDGES: [(f64, &str); 7] = [
+    (2.0, "under 2"),
+    (4.0, "2 to 4"),
+    (8.0, "4 to 8"),
+    (12.0, "8 to 12"),
     (25.0, "12 to 25"),
     (50.0, "25 to 50"),
     (f64::INFINITY, "50 and more"),
 ];
 
-/// Sticky loops called stiction, by band (Stenman d, Kano S, He fs) over the OP's noise (Kc
-/// times the PV's noise standard deviation), for records under 5 s apart and slower.
+/// Sticky loops called stiction, by band (Stenman d, Kano S, He fs) over the OP's noise standard
+/// deviation (as the diagnosis measured it), for records under 5 s apart and slower.
 pub(super) fn detectability_table(md: &mut String, groups: &Groups) {
     // (called, loops) per row, for fine and coarse records
     let mut cells = [[(0usize, 0usize); 2]; EDGES.len()];
@@ -28,10 +30,10 @@ pub(super) fn detectability_table(md: &mut String, groups: &Groups) {
             continue;
         }
         for (l, d) in items {
-            let op_noise = (l.setup.pi.kc * l.setup.noise).abs();
-            if op_noise <= 0.0 {
+            // OP's noise as the diagnosis measured it (its reach), OP units = % of span here
+            let Some(op_noise) = d.reach.as_ref().map(|r| r.op_noise) else {
                 continue;
-            }
+            };
             let ratio = l.setup.model.values()[0] / op_noise;
             let Some(row) = EDGES.iter().position(|&(hi, _)| ratio < hi) else {
                 continue;
@@ -43,7 +45,7 @@ pub(super) fn detectability_table(md: &mut String, groups: &Groups) {
     }
     let _ = writeln!(
         md,
-        "Sticky loops called stiction, by band (Stenman d, Kano S, He fs) over the OP's noise (the controller gain times the PV's noise standard deviation: what proportional action passes on to OP):\n"
+        "Sticky loops called stiction, by band (Stenman d, Kano S, He fs) over the OP's noise standard deviation as the diagnosis measured it (its `reach`; mostly what proportional action passes on to OP of the PV's noise). `diagnose` reports the shares found under 4 and over 12 on the calibration draws (`diagnose::reach`):\n"
     );
     let _ = writeln!(
         md,

@@ -144,7 +144,7 @@ impl<'a> Beside<'a> {
             // as the families measured it, on the same stretch
             op_noise: family(Family::StickSlip)
                 .and_then(|f| f.stick_slip.as_ref())
-                .map_or_else(|| crate::detect::measurement_noise(sub.op), |s| s.op_noise),
+                .map_or_else(|| crate::detect::held_noise(sub.op), |s| s.op_noise),
         }
     }
 }

@@ -10,6 +10,7 @@
 //!   hidden valve), one file each behind a trait;
 //! - `verdict`: families that agree decide, families that conflict give `undetermined`;
 //! - `band`: when the verdict is `stiction`, the band in % of valve span and where it comes from;
+//! - [`reach`]: the bands a record like this one shows and hides, from OP's noise;
 //! - `windows`: the same judgement per window of the record.
 
 mod band;
@@ -17,6 +18,7 @@ mod bridge;
 pub mod evidence;
 mod gates;
 pub mod oscillation;
+pub mod reach;
 mod request;
 mod result;
 mod saturation;
@@ -27,6 +29,7 @@ mod windows;
 
 pub use evidence::{Family, FamilyEvidence};
 pub use oscillation::noise_std;
+pub use reach::Reach;
 pub use request::{DiagnoseError, DiagnoseRequest};
 pub use result::{
     Band, BandSource, Diagnosis, Index, Oscillation, SetpointReadOff, Verdict, Vote, WindowVerdict,
@@ -93,7 +96,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         oscillation,
         pv_noise,
         setpoint_steps: inferred.as_ref().map_or(0, |i| i.steps.len()),
-        op_noise: crate::detect::measurement_noise(r.op),
+        op_noise: crate::detect::held_noise(r.op),
         pv_quantum: quality::quantum(r.pv),
         unrecorded: quality::unrecorded(r.pv),
         fits,
@@ -220,6 +223,7 @@ pub fn diagnose_checked(
         oscillation: None,
         families: Vec::new(),
         indices: Vec::new(),
+        reach: None,
         band: None,
         quantification: None,
         quantified: None,
@@ -254,6 +258,7 @@ pub fn diagnose_checked(
     d.next_step = j.decision.next_step;
     d.families = j.families;
     d.indices = j.indices;
+    d.reach = reach::of(&d, sub.op, req);
     let mut osc = j.oscillation;
     osc.stretch = [osc.stretch[0] + s, osc.stretch[1] + s];
     if d.verdict == Verdict::Stiction {

@@ -266,6 +266,10 @@ pub struct Diagnosis {
     pub families: Vec<FamilyEvidence>,
     /// The shape family's indices (on an oscillating stretch).
     pub indices: Vec<Index>,
+    /// The bands a record like this one shows and hides, from OP's noise (on every judged
+    /// record; what a `no_stiction` verdict speaks for).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reach: Option<super::Reach>,
     /// The stiction band, when the verdict is `stiction`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub band: Option<Band>,

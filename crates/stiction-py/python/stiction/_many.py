@@ -22,6 +22,7 @@ FLEET_COLUMNS = [
     "band_percent_of_span",
     "band_source",
     "ellipse_percent_of_span",
+    "small_band_percent_of_span",
     "period_s",
     "regularity",
     "reason",

@@ -36,6 +36,7 @@ def schema(by_field: Any) -> Any:
         "band_percent_of_span": DoubleType(),
         "band_source": StringType(),
         "ellipse_percent_of_span": DoubleType(),
+        "small_band_percent_of_span": DoubleType(),
         "period_s": DoubleType(),
         "regularity": DoubleType(),
         "reason": StringType(),

@@ -10,7 +10,7 @@ use crate::words::{capital, duration, num, verdict};
 use crate::{ColumnNames, LoopData};
 use anyhow::Result;
 use serde::Serialize;
-use stiction_core::diagnose::Diagnosis;
+use stiction_core::diagnose::{Diagnosis, Verdict};
 use stiction_core::quantify::{Quantification, QuantifyStatus};
 
 mod figures;
@@ -62,6 +62,8 @@ pub struct VerdictBox {
     pub evidence: Vec<String>,
     pub band: Option<BandLine>,
     pub next_step: String,
+    /// What a record like this one can show (verdicts other than stiction).
+    pub reach: Option<String>,
 }
 
 #[derive(Serialize)]
@@ -231,6 +233,11 @@ fn verdict_box(d: &Diagnosis) -> VerdictBox {
             source: b.source.words(),
         }),
         next_step: d.next_step.clone(),
+        reach: d
+            .reach
+            .as_ref()
+            .filter(|_| d.verdict != Verdict::Stiction)
+            .map(|r| r.words()),
     }
 }
 
