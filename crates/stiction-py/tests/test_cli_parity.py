@@ -37,6 +37,7 @@ def test_diagnose_healthy_equals_cli_with_windows(cli, healthy_csv):
     got = stiction.diagnose(pd.read_csv(healthy_csv), sp="sp", window=500, quantify=False)
     assert without_seconds(got.to_dict()) == without_seconds(want)
     assert got.verdict == "no_stiction"
+    assert abs(got.reach["large_band_percent_of_span"] - 3 * got.reach["small_band_percent_of_span"]) < 1e-9
     assert len(got.windows) == len(want["windows"]) == 3
     assert list(got.windows["verdict"]) == [w["verdict"] for w in want["windows"]]
 

@@ -22,6 +22,8 @@ def test_rows_ranked_and_a_failing_loop(fleet):
     row = out.set_index("loop_id").loc["FIC101"]
     assert row["verdict"] == d.verdict and row["confidence"] == d.confidence
     assert row["band_percent_of_span"] == d.band_percent
+    # the record's small band, from its OP noise, as the diagnosis reports it
+    assert row["small_band_percent_of_span"] == d.reach["small_band_percent_of_span"] > 0
 
 
 def test_the_same_for_any_thread_count(fleet):

@@ -45,7 +45,9 @@ class Diagnosis(_Result):
 
     Main attributes: ``verdict`` (``stiction``, ``no_stiction``, ``undetermined``,
     ``insufficient_data``), ``confidence``, ``reason``, ``next_step``, ``band`` (the stiction band
-    in % of valve span and where it comes from, for a ``stiction`` verdict), ``families`` (the
+    in % of valve span and where it comes from, for a ``stiction`` verdict), ``reach`` (the bands
+    the record hides, from OP's noise: what a ``no_stiction`` verdict says little about),
+    ``families`` (the
     evidence and their votes), ``indices`` (the shape indices), ``oscillation``, ``quality``
     (the data-quality gates), ``samples``, ``ts``, ``warnings``; without a setpoint column,
     ``setpoint_read_off`` (the setpoint's steps read off OP and PV, and the levels between) when
