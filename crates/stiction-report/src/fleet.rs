@@ -7,6 +7,7 @@ use super::{render_template, Link};
 use crate::words::{self, num};
 use anyhow::Result;
 use serde::Serialize;
+use stiction_core::diagnose::reach;
 use stiction_core::fleet::{Counts, Outcome, Row};
 
 /// Points per series of a sparkline: 50 buckets, the lowest and highest sample of each.
@@ -106,6 +107,9 @@ pub struct FleetRow {
     pub confidence: Cell,
     pub severity: Cell,
     pub band: Cell,
+    /// Where the verdict is not `stiction`: the band, % of span, under which a sticky valve
+    /// mostly goes unseen in a record with this OP's noise (`Reach::small_band_percent_of_span`).
+    pub hidden: Cell,
     pub period: Cell,
     pub reason: String,
     pub spark: Option<SparkPoints>,
@@ -157,6 +161,14 @@ struct FleetPage<'a> {
     counts: Vec<Count>,
     rows: &'a [FleetRow],
     back: Option<Link>,
+    reach: ReachWords,
+}
+
+/// What the "hidden under" column means, from the calibration of `diagnose::reach`.
+#[derive(Serialize)]
+struct ReachWords {
+    times: String,
+    found: String,
 }
 
 /// One loop of the page: the fleet row, its source in words, whether it has a report, its
@@ -186,6 +198,10 @@ pub fn row(rank: usize, e: &Entry) -> FleetRow {
         confidence: cell(r.confidence),
         severity: cell(Some(r.severity)),
         band: cell(r.band_percent_of_span),
+        hidden: cell(
+            r.small_band_percent_of_span
+                .filter(|_| r.verdict != Outcome::Stiction),
+        ),
         period: match (cell(r.period_s), e.same_period) {
             (c, 0) => c,
             (Cell { text, key }, n) => Cell {
@@ -224,6 +240,14 @@ pub fn page(rows: &[FleetRow], counts: &Counts, complete: bool) -> Result<String
             counts,
             rows,
             back: None,
+            reach: ReachWords {
+                times: format!("{}", reach::SMALL),
+                found: format!(
+                    "{:.0}-{:.0} %",
+                    100.0 * reach::FOUND_SMALL[0],
+                    100.0 * reach::FOUND_SMALL[1]
+                ),
+            },
         },
     )
 }

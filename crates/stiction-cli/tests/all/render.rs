@@ -184,6 +184,22 @@ fn the_fleet_page_sorts_filters_and_shows_sparklines() {
     assert!(index.contains("data-key="));
     // the band in % of span; cards on a phone
     assert!(index.contains("Band (% of span)"));
+    // what a loop not called sticky may still hide: its cell carries a band, a sticky one's none
+    assert!(index.contains("Hidden under (% of span)"));
+    let hidden: Vec<&str> = index
+        .split("data-label=\"Hidden under (% of span)\" data-key=\"")
+        .skip(1)
+        .map(|c| &c[..c.find('"').unwrap()])
+        .collect();
+    assert_eq!(hidden.len(), 3);
+    assert_eq!(
+        hidden.iter().filter(|k| k.is_empty()).count(),
+        2,
+        "{hidden:?}"
+    );
+    assert!(hidden
+        .iter()
+        .any(|k| k.parse::<f64>().is_ok_and(|b| b > 0.0)));
     assert!(index.contains("@media (max-width: 600px)"));
     assert!(index.contains("data-label=\"Verdict\""));
     // one stylesheet with the reports
