@@ -65,16 +65,25 @@ pub(super) fn constant_setpoint(
     let Some(sp) = sp else {
         return (start, end);
     };
-    let (mut best, mut s) = ((start, start), start);
-    for k in start + 1..=end {
-        if k == end || sp[k] != sp[k - 1] {
-            if k - s > best.1 - best.0 {
-                best = (s, k);
-            }
-            s = k;
+    holds(sp, (start, end)).fold((start, start), |best, h| {
+        if h.1 - h.0 > best.1 - best.0 {
+            h
+        } else {
+            best
         }
-    }
-    best
+    })
+}
+
+/// The stretches `[s, e)` of `[start, end)` over which the setpoint holds its value, in order.
+fn holds(sp: &[f64], (start, end): (usize, usize)) -> impl Iterator<Item = (usize, usize)> + '_ {
+    let mut s = start;
+    (start + 1..=end).filter_map(move |k| {
+        (k == end || sp[k] != sp[k - 1]).then(|| {
+            let hold = (s, k);
+            s = k;
+            hold
+        })
+    })
 }
 
 /// Share of the error's variance in its cycle at which an oscillation across setpoint changes
@@ -150,20 +159,12 @@ fn other_hold(
     ts: f64,
     longest: (usize, usize),
 ) -> Option<Oscillation> {
-    let sp = sp?;
     let n = error.len();
-    let mut holds = Vec::new();
-    let mut s = 0;
-    for k in 1..=n {
-        if k == n || sp[k] != sp[k - 1] {
-            if (s, k) != longest && (k - s) as f64 >= OTHER_HOLD_SHARE * n as f64 {
-                holds.push((s, k));
-            }
-            s = k;
-        }
-    }
-    holds.sort_by_key(|&(s, e)| std::cmp::Reverse(e - s));
-    holds.into_iter().find_map(|(s, e)| {
+    let mut others: Vec<_> = holds(sp?, (0, n))
+        .filter(|&(s, e)| (s, e) != longest && (e - s) as f64 >= OTHER_HOLD_SHARE * n as f64)
+        .collect();
+    others.sort_by_key(|&(s, e)| std::cmp::Reverse(e - s));
+    others.into_iter().find_map(|(s, e)| {
         let o = oscillation(&error[s..e], ts, (s, e));
         (o.oscillating
             && o.periods_in_record.is_some_and(|p| p >= OTHER_HOLD_CYCLES)
