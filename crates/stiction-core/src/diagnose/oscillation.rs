@@ -77,13 +77,9 @@ pub(super) fn constant_setpoint(
 /// The stretches `[s, e)` of `[start, end)` over which the setpoint holds its value, in order.
 fn holds(sp: &[f64], (start, end): (usize, usize)) -> impl Iterator<Item = (usize, usize)> + '_ {
     let mut s = start;
-    (start + 1..=end).filter_map(move |k| {
-        (k == end || sp[k] != sp[k - 1]).then(|| {
-            let hold = (s, k);
-            s = k;
-            hold
-        })
-    })
+    (start + 1..=end)
+        .filter(move |&k| k == end || sp[k] != sp[k - 1])
+        .map(move |k| (std::mem::replace(&mut s, k), k))
 }
 
 /// Share of the error's variance in its cycle at which an oscillation across setpoint changes
