@@ -242,11 +242,7 @@ pub fn page(rows: &[FleetRow], counts: &Counts, complete: bool) -> Result<String
             back: None,
             reach: ReachWords {
                 times: format!("{}", reach::SMALL),
-                found: format!(
-                    "{:.0}-{:.0} %",
-                    100.0 * reach::FOUND_SMALL[0],
-                    100.0 * reach::FOUND_SMALL[1]
-                ),
+                found: reach::found_words(reach::FOUND_SMALL),
             },
         },
     )

@@ -61,16 +61,20 @@ impl Reach {
 
     /// One sentence for a person.
     pub fn words(&self) -> String {
-        let pct = |s: [f64; 2]| format!("{:.0}-{:.0} %", 100.0 * s[0], 100.0 * s[1]);
         format!(
             "a sticky valve with a band under {:.2} % of span ({SMALL:.0} times OP's noise, a standard deviation of {:.3} %) was found in {} of simulated records, one over {:.2} % ({LARGE:.0} times) in {}",
             self.small_band_percent_of_span,
             self.op_noise_percent_of_span,
-            pct(self.found_small),
+            found_words(self.found_small),
             self.large_band_percent_of_span,
-            pct(self.found_large)
+            found_words(self.found_large)
         )
     }
+}
+
+/// A range of shares found (`FOUND_SMALL`, `FOUND_LARGE`) in words: "12-41 %".
+pub fn found_words(found: [f64; 2]) -> String {
+    format!("{:.0}-{:.0} %", 100.0 * found[0], 100.0 * found[1])
 }
 
 /// The reach of the stretch judged in `d` (OP `op`): OP's noise as the stick-slip family measured
