@@ -7,6 +7,10 @@ use stiction_core::diagnose::{BandSource, Diagnosis, Verdict, Vote};
 /// Why a weak cycle (`Oscillation::weak_cycle`) counts, for the oscillation line.
 const WEAK_CYCLE: &str = "its half periods clear 1.5 noise standard deviations, not 3, and its period wanders as a limit cycle's does beside noise";
 
+/// How a period read through the autocorrelation's noise band (`Oscillation::through_noise_band`)
+/// was read, for the oscillation line.
+const THROUGH_NOISE_BAND: &str = "its period wanders: read with the autocorrelation's zero crossings taken through its noise band";
+
 fn band_source(s: BandSource) -> &'static str {
     match s {
         BandSource::Valve => "from the recorded valve position",
@@ -172,7 +176,7 @@ fn record(d: &Diagnosis) {
     );
     if let Some(o) = &d.oscillation {
         println!(
-            "  oscillation: {}; period {}; regularity {:.2} (threshold {}); {} half periods with a large IAE",
+            "  oscillation: {}{}; period {}; regularity {:.2} (threshold {}); {} half periods with a large IAE",
             match (o.oscillating, o.across_setpoint_steps, o.weak_cycle) {
                 (true, true, false) =>
                     "yes, across the setpoint's steps (its holds are too short)".to_string(),
@@ -182,6 +186,11 @@ fn record(d: &Diagnosis) {
                 (true, false, true) => format!("yes, a weak cycle ({WEAK_CYCLE})"),
                 (true, false, false) => "yes".to_string(),
                 _ => "no".to_string(),
+            },
+            if o.oscillating && o.through_noise_band {
+                format!(" ({THROUGH_NOISE_BAND})")
+            } else {
+                String::new()
             },
             o.period.map_or("-".into(), |p| format!("{p:.1} s")),
             o.regularity.regularity,

@@ -582,6 +582,27 @@ fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
     assert_ne!(v["verdict"], "stiction", "{v:#}");
 }
 
+/// The same valve and noise with another seed: the cycle's period wanders, and read plainly the
+/// autocorrelation's scatter near zero breaks its periods up; read through its noise band it is an
+/// oscillation, and the output says how it was read. The healthy valve's loop has none either way.
+#[test]
+fn a_wandering_cycle_is_read_through_the_noise_band_and_said_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let extra = ["--noise", "0.45", "--seed", "1", "--samples", "2000"];
+    let f = closed_loop(dir.path(), "wandering.csv", "0.5", &extra);
+    let o = &sp_json(&f)["oscillation"];
+    assert_eq!(o["oscillating"], true, "{o:#}");
+    assert_eq!(o["through_noise_band"], true, "{o:#}");
+    let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
+    assert!(
+        text.contains("zero crossings taken through its noise band"),
+        "{text}"
+    );
+    let o = &sp_json(&closed_loop(dir.path(), "healthy.csv", "0", &extra))["oscillation"];
+    assert_eq!(o["oscillating"], false, "{o:#}");
+    assert!(o.get("through_noise_band").is_none(), "{o:#}");
+}
+
 /// A sticky valve's cycle only 2.5 noise standard deviations high (Stenman 0.5 %, PV noise 0.45)
 /// is a weak cycle: an oscillation, and said to be one; the healthy valve's loop in the same
 /// noise has none.

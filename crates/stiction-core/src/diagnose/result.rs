@@ -103,6 +103,11 @@ pub struct Oscillation {
     /// and half of it), when a period was found.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle_share: Option<f64>,
+    /// The period was read with the autocorrelation's zero crossings taken through its noise
+    /// band (one standard error either side of zero): read plainly, the estimate's scatter near
+    /// zero broke a wandering cycle's periods up.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub through_noise_band: bool,
 }
 
 /// Where the band in the verdict comes from.

@@ -20,6 +20,9 @@ pub fn oscillation(d: &Diagnosis) -> Option<Vec<KvRow>> {
             } else if o.oscillating && o.across_setpoint_steps {
                 "yes: regular and above the noise, across the setpoint's steps (no hold is long enough)"
                     .to_string()
+            } else if o.oscillating && o.through_noise_band {
+                "yes: above the noise, its period wandering (read with the autocorrelation's zero crossings taken through its noise band)"
+                    .to_string()
             } else if o.oscillating {
                 "yes: regular and above the noise".to_string()
             } else {

@@ -112,14 +112,61 @@ const MAX_SETPOINT_CHANGES: f64 = 0.02;
 /// knife-edged: at 0.2 the calibration set gains one more sticky loop, at 0.4 one fewer, and no
 /// look-alike is called sticky at either (the benchmark set: 4 more sticky loops at 0.2 and 0.3,
 /// 2 at 0.4).
+///
+/// Where none of these oscillates, the same again with the autocorrelation's zero crossings read
+/// through its noise band ([`Crossings::Banded`]).
 pub(super) fn of_record(error: &[f64], sp: Option<&[f64]>, ts: f64) -> Oscillation {
+    let plain = read(error, sp, ts, Crossings::Plain);
+    if plain.oscillating {
+        return plain;
+    }
+    let banded = read(error, sp, ts, Crossings::Banded);
+    if banded.oscillating {
+        banded
+    } else {
+        plain
+    }
+}
+
+/// How the autocorrelation's zero crossings are read for the periods.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Crossings {
+    /// Every crossing (Thornhill's reading).
+    Plain,
+    /// Through a band of [`CROSSING_BAND`] standard errors either side of zero
+    /// (`detect::regularity_banded`); a cycle found so must hold [`BANDED_CYCLE_SHARE`] of the
+    /// error's variance.
+    Banded,
+}
+
+/// The band the zero crossings are read through, in standard errors of a white noise's
+/// autocorrelation at a lag (1/√n for a stretch of n samples).
+pub const CROSSING_BAND: f64 = 1.0;
+
+/// A cycle found only through the band holds at least this share of the error's variance (a
+/// load's steps or a slow drift can leave a regular-looking autocorrelation with almost none).
+///
+/// Both set on the catalogue's calibration set and draws 1-3 (2,880 loops): 8 more sticky valves
+/// called `stiction`, no look-alike more (one aggressive tuning moved from `insufficient_data` to
+/// `no_stiction`); through a band of 0.5 standard errors the same 8 but 2 sticky valves lost and 2
+/// look-alikes called `stiction`, of 2 standard errors 6 more and one look-alike; without the
+/// share, the same 8 and a load's steps called `stiction` (a share of 0.006) and four
+/// look-alikes moved from `insufficient_data` to `undetermined` (shares under 0.03), where the
+/// sticky valves found hold 0.06 to 0.32. Checked after on draws 4-7 and both benchmark sets
+/// (4,560 loops): 9 more sticky valves called `stiction` (3 of the routine benchmark's), and two
+/// look-alikes (a narrow-band load cycle at 10 s and a noisy healthy fast loop, both on the shape
+/// indices' vote) and a backlash-only valve; the ISDB and the 108 loops: no verdict changed.
+pub const BANDED_CYCLE_SHARE: f64 = 0.05;
+
+fn read(error: &[f64], sp: Option<&[f64]>, ts: f64, crossings: Crossings) -> Oscillation {
+    let oscillation = |e: &[f64], stretch: (usize, usize)| read_stretch(e, ts, stretch, crossings);
     let n = error.len();
     let (os, oe) = constant_setpoint(sp, (0, n));
-    let held = oscillation(&error[os..oe], ts, (os, oe));
+    let held = oscillation(&error[os..oe], (os, oe));
     if held.oscillating || oe - os == n {
         return held;
     }
-    let whole = oscillation(error, ts, (0, n));
+    let whole = oscillation(error, (0, n));
     if whole.oscillating
         && whole.cycle_share.is_some_and(|c| c >= CYCLE_SHARE_WHOLE)
         && setpoint_steps(sp, whole.periods_in_record)
@@ -129,7 +176,7 @@ pub(super) fn of_record(error: &[f64], sp: Option<&[f64]>, ts: f64) -> Oscillati
             ..whole
         };
     }
-    other_hold(error, sp, ts, (os, oe)).unwrap_or(held)
+    other_hold(error, sp, (os, oe), oscillation).unwrap_or(held)
 }
 
 /// A hold of the setpoint other than the longest counts when it spans at least this share of the
@@ -152,8 +199,8 @@ const OTHER_HOLD_CYCLES: f64 = 5.0;
 fn other_hold(
     error: &[f64],
     sp: Option<&[f64]>,
-    ts: f64,
     longest: (usize, usize),
+    oscillation: impl Fn(&[f64], (usize, usize)) -> Oscillation,
 ) -> Option<Oscillation> {
     let n = error.len();
     let mut others: Vec<_> = holds(sp?, (0, n))
@@ -161,7 +208,7 @@ fn other_hold(
         .collect();
     others.sort_by_key(|&(s, e)| std::cmp::Reverse(e - s));
     others.into_iter().find_map(|(s, e)| {
-        let o = oscillation(&error[s..e], ts, (s, e));
+        let o = oscillation(&error[s..e], (s, e));
         (o.oscillating
             && o.periods_in_record.is_some_and(|p| p >= OTHER_HOLD_CYCLES)
             && o.cycle_share.is_some_and(|c| c >= CYCLE_SHARE_WHOLE))
@@ -208,9 +255,25 @@ fn weak_free_cycle(
 }
 
 /// The oscillation of the control error `error` (sampled every `ts` s) over `stretch`.
-pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Oscillation {
+#[cfg(test)]
+fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Oscillation {
+    read_stretch(error, ts, stretch, Crossings::Plain)
+}
+
+/// The oscillation of `error` over `stretch`, its crossings read as `crossings` says.
+fn read_stretch(
+    error: &[f64],
+    ts: f64,
+    stretch: (usize, usize),
+    crossings: Crossings,
+) -> Oscillation {
     let acf = detect::autocorrelation(error, error.len() / 2);
-    let regularity = detect::regularity_of(&acf, ts);
+    let regularity = match crossings {
+        Crossings::Plain => detect::regularity_of(&acf, ts),
+        Crossings::Banded => {
+            detect::regularity_banded(&acf, ts, CROSSING_BAND / (error.len() as f64).sqrt())
+        }
+    };
     let noise = crate::detect::measurement_noise(error);
     let amp = amplitude(error);
     let period = regularity.period;
@@ -235,7 +298,8 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
         above && iae.exceedances < 4 && weak_free_cycle(error, ts, &settings, &regularity, noise);
     let regular = above && (iae.exceedances >= 4 || weak_cycle);
     let counted = iae.oscillating && amp > 3.0 * noise;
-    let oscillating = regular || counted;
+    let oscillating = (regular || counted)
+        && (crossings == Crossings::Plain || cycle_share.is_some_and(|c| c >= BANDED_CYCLE_SHARE));
     Oscillation {
         oscillating,
         period,
@@ -248,6 +312,7 @@ pub(super) fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Os
         across_setpoint_steps: false,
         weak_cycle: weak_cycle && !counted,
         cycle_share,
+        through_noise_band: crossings == Crossings::Banded,
     }
 }
 
@@ -269,159 +334,4 @@ fn cycle_share(acf: &[f64], samples: usize, period: f64) -> Option<f64> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_longest_constant_setpoint_stretch() {
-        let mut sp = vec![1.0; 100];
-        sp[30..].fill(2.0);
-        sp[40..].fill(3.0);
-        assert_eq!(constant_setpoint(Some(&sp), (0, 100)), (40, 100));
-        assert_eq!(constant_setpoint(Some(&sp), (0, 35)), (0, 30));
-        assert_eq!(constant_setpoint(None, (5, 9)), (5, 9));
-    }
-
-    /// A valve that sticks through one hold of the setpoint while the load drifts, then cycles
-    /// through the next: the cycle is judged on that hold, not missed on the longest one.
-    #[test]
-    fn a_cycle_in_a_shorter_hold_of_the_setpoint_counts() {
-        let noise = sine_in_noise(2000, 40.0, 0.1);
-        let record = |cycle_from: usize| -> (Vec<f64>, Vec<f64>) {
-            let error = (0..2000)
-                .map(|k| {
-                    if k < cycle_from {
-                        // noise about a drift (the sine removed): no cycle
-                        let sine = (std::f64::consts::TAU * k as f64 / 40.0).sin();
-                        noise[k] - sine + 5.0 * k as f64 / cycle_from as f64
-                    } else {
-                        noise[k]
-                    }
-                })
-                .collect();
-            let sp = (0..2000)
-                .map(|k| if k < cycle_from { 1.0 } else { 2.0 })
-                .collect();
-            (error, sp)
-        };
-        let (error, sp) = record(1400);
-        let o = of_record(&error, Some(&sp), 1.0);
-        assert!(o.oscillating);
-        assert_eq!(o.stretch, [1400, 2000]);
-        assert!(!o.across_setpoint_steps);
-        assert!((o.period.unwrap() - 40.0).abs() < 2.0, "{:?}", o.period);
-        // a hold of under a fifth of the record is not searched
-        let (error, sp) = record(1700);
-        let o = of_record(&error, Some(&sp), 1.0);
-        assert_eq!(o.stretch, [0, 1700]);
-        assert!(!o.oscillating);
-    }
-
-    /// A sine of `period` samples and unit amplitude in white noise of standard deviation `sigma`.
-    fn sine_in_noise(n: usize, period: f64, sigma: f64) -> Vec<f64> {
-        use rand::{RngExt, SeedableRng};
-        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(7);
-        (0..n)
-            .map(|k| {
-                let u: f64 = rng.random::<f64>() - 0.5;
-                (std::f64::consts::TAU * k as f64 / period).sin() + sigma * 12f64.sqrt() * u
-            })
-            .collect()
-    }
-
-    #[test]
-    fn the_cycle_share_of_a_sine_in_noise_is_its_share_of_the_variance() {
-        // variance 0.5 of the sine beside 0.5 of the noise: half
-        let x = sine_in_noise(4000, 40.0, 0.5f64.sqrt());
-        let share =
-            |x: &[f64]| cycle_share(&detect::autocorrelation(x, x.len() / 2), x.len(), 40.0);
-        let c = share(&x).unwrap();
-        assert!((c - 0.5).abs() < 0.05, "{c}");
-        // a slow drift raises the period's lag and the half period's alike
-        let drift: Vec<f64> = x
-            .iter()
-            .enumerate()
-            .map(|(k, v)| v + 0.002 * k as f64)
-            .collect();
-        assert!(share(&drift).unwrap() < 0.6);
-        assert!(share(&x[..60]).is_none());
-    }
-
-    #[test]
-    fn a_cycle_across_setpoint_steps_counts_unless_the_setpoint_moves_all_the_time() {
-        // the setpoint steps every 60 samples: no hold has two whole cycles of 40 samples
-        let n = 2000;
-        let cycle = sine_in_noise(n, 40.0, 0.2);
-        let steps: Vec<f64> = (0..n).map(|k| 50.0 + ((k / 60) % 3) as f64).collect();
-        let o = of_record(&cycle, Some(&steps), 1.0);
-        assert!(o.oscillating && o.across_setpoint_steps, "{o:?}");
-        assert_eq!(o.stretch, [0, n]);
-        assert!((o.period.unwrap() - 40.0).abs() < 2.0);
-        // a setpoint that moves at every sample (a cascade's inner loop): the cycle may be its own
-        let moving: Vec<f64> = (0..n).map(|k| 50.0 + 0.001 * k as f64).collect();
-        let o = of_record(&cycle, Some(&moving), 1.0);
-        assert!(!o.across_setpoint_steps, "{o:?}");
-        // steps more often than the cycle: the train of their responses, not a cycle
-        let fast: Vec<f64> = (0..n).map(|k| 50.0 + ((k / 30) % 2) as f64).collect();
-        assert!(!setpoint_steps(Some(&fast), Some(50.0)));
-        assert!(setpoint_steps(Some(&steps), Some(50.0)));
-        assert!(!setpoint_steps(None, Some(50.0)));
-    }
-
-    /// A cycle of unit amplitude whose phase wanders (each sample's phase step off by up to
-    /// `wander` of its own, at random), in white noise of standard deviation `sigma`.
-    fn wandering_in_noise(n: usize, period: f64, sigma: f64, wander: f64) -> Vec<f64> {
-        use rand::{RngExt, SeedableRng};
-        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(11);
-        let mut phase = 0.0;
-        (0..n)
-            .map(|_| {
-                let u: f64 = rng.random::<f64>() - 0.5;
-                let e: f64 = rng.random::<f64>() - 0.5;
-                phase += std::f64::consts::TAU / period * (1.0 + 2.0 * wander * u);
-                phase.sin() + sigma * 12f64.sqrt() * e
-            })
-            .collect()
-    }
-
-    #[test]
-    fn a_weak_cycle_counts_when_it_keeps_no_clock() {
-        let (n, sigma) = (2000, 0.4);
-        let free = wandering_in_noise(n, 40.0, sigma, 1.5);
-        let clock = sine_in_noise(n, 40.0, sigma);
-        // both about 3 noise standard deviations: too small for Hägglund's count
-        let o = oscillation(&free, 1.0, (0, n));
-        assert!(o.iae.exceedances < 4, "{o:?}");
-        // the free cycle's period wanders, and it repeats large areas at 1.5
-        assert!(
-            o.regularity.regularity < 10.0 && o.regularity.oscillating,
-            "{o:?}"
-        );
-        assert!(o.oscillating && o.weak_cycle, "{o:?}");
-        // the same cycle keeping a clock's time is an input's: not counted
-        let o = oscillation(&clock, 1.0, (0, n));
-        assert!(
-            o.regularity.regularity > FORCED_REGULARITY && o.iae.exceedances < 4,
-            "{o:?}"
-        );
-        assert!(!o.oscillating, "{o:?}");
-        // noise alone is not a cycle
-        let o = oscillation(&wandering_in_noise(n, 40.0, 3.0, 1.5), 1.0, (0, n));
-        assert!(!o.oscillating, "{o:?}");
-    }
-
-    #[test]
-    fn noise_std_of_white_noise_and_a_step() {
-        // alternating ±1 has first differences of 2: sigma = 2 / 0.6745 / sqrt 2
-        let mut x: Vec<f64> = (0..200)
-            .map(|k| if k % 2 == 0 { 1.0 } else { -1.0 })
-            .collect();
-        let s = noise_std(&x);
-        assert!((s - 2.0 / 0.6745 / std::f64::consts::SQRT_2).abs() < 1e-12);
-        // a single large step barely moves it
-        for v in &mut x[100..] {
-            *v += 50.0;
-        }
-        assert!((noise_std(&x) - s).abs() < 1e-12);
-    }
-}
+mod tests;
