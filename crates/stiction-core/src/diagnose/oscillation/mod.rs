@@ -148,8 +148,9 @@ pub const CROSSING_BAND: f64 = 1.0;
 ///
 /// Both set on the catalogue's calibration set and draws 1-3 (2,880 loops): 8 more sticky valves
 /// called `stiction`, no look-alike more (one aggressive tuning moved from `insufficient_data` to
-/// `no_stiction`); through a band of 0.5 standard errors the same 8 but 2 sticky valves lost and 2
-/// look-alikes called `stiction`, of 2 standard errors 6 more and one look-alike; without the
+/// `no_stiction`); read through the band on each stretch that showed no cycle (before the other
+/// holds were tried), a band of 0.5 standard errors found the same 8 but lost 2 sticky valves and
+/// called 2 look-alikes `stiction`, one of 2 standard errors 6 more and one look-alike; without the
 /// share, the same 8 and a load's steps called `stiction` (a share of 0.006) and four
 /// look-alikes moved from `insufficient_data` to `undetermined` (shares under 0.03), where the
 /// sticky valves found hold 0.06 to 0.32. Checked after on draws 4-7 and both benchmark sets
@@ -158,6 +159,8 @@ pub const CROSSING_BAND: f64 = 1.0;
 /// indices' vote) and a backlash-only valve; the ISDB and the 108 loops: no verdict changed.
 pub const BANDED_CYCLE_SHARE: f64 = 0.05;
 
+/// The oscillation of the record with its crossings read as `crossings` says: on the longest
+/// hold of the setpoint, else across the steps, else on another hold (see [`of_record`]).
 fn read(error: &[f64], sp: Option<&[f64]>, ts: f64, crossings: Crossings) -> Oscillation {
     let oscillation = |e: &[f64], stretch: (usize, usize)| read_stretch(e, ts, stretch, crossings);
     let n = error.len();
