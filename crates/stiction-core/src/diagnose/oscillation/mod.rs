@@ -116,11 +116,12 @@ const MAX_SETPOINT_CHANGES: f64 = 0.02;
 /// Where none of these oscillates, the same again with the autocorrelation's zero crossings read
 /// through its noise band ([`Crossings::Banded`]).
 pub(super) fn of_record(error: &[f64], sp: Option<&[f64]>, ts: f64) -> Oscillation {
-    let plain = read(error, sp, ts, Crossings::Plain);
+    let mut bases = Bases::default();
+    let plain = read(error, sp, ts, Crossings::Plain, &mut bases);
     if plain.oscillating {
         return plain;
     }
-    let banded = read(error, sp, ts, Crossings::Banded);
+    let banded = read(error, sp, ts, Crossings::Banded, &mut bases);
     if banded.oscillating {
         banded
     } else {
@@ -161,15 +162,23 @@ pub const BANDED_CYCLE_SHARE: f64 = 0.05;
 
 /// The oscillation of the record with its crossings read as `crossings` says: on the longest
 /// hold of the setpoint, else across the steps, else on another hold (see [`of_record`]).
-fn read(error: &[f64], sp: Option<&[f64]>, ts: f64, crossings: Crossings) -> Oscillation {
-    let oscillation = |e: &[f64], stretch: (usize, usize)| read_stretch(e, ts, stretch, crossings);
+fn read(
+    error: &[f64],
+    sp: Option<&[f64]>,
+    ts: f64,
+    crossings: Crossings,
+    bases: &mut Bases,
+) -> Oscillation {
+    let mut oscillation = |(s, e): (usize, usize)| {
+        read_stretch(&error[s..e], ts, (s, e), crossings, bases.of(error, (s, e)))
+    };
     let n = error.len();
     let (os, oe) = constant_setpoint(sp, (0, n));
-    let held = oscillation(&error[os..oe], (os, oe));
+    let held = oscillation((os, oe));
     if held.oscillating || oe - os == n {
         return held;
     }
-    let whole = oscillation(error, (0, n));
+    let whole = oscillation((0, n));
     if whole.oscillating
         && whole.cycle_share.is_some_and(|c| c >= CYCLE_SHARE_WHOLE)
         && setpoint_steps(sp, whole.periods_in_record)
@@ -203,7 +212,7 @@ fn other_hold(
     error: &[f64],
     sp: Option<&[f64]>,
     longest: (usize, usize),
-    oscillation: impl Fn(&[f64], (usize, usize)) -> Oscillation,
+    mut oscillation: impl FnMut((usize, usize)) -> Oscillation,
 ) -> Option<Oscillation> {
     let n = error.len();
     let mut others: Vec<_> = holds(sp?, (0, n))
@@ -211,7 +220,7 @@ fn other_hold(
         .collect();
     others.sort_by_key(|&(s, e)| std::cmp::Reverse(e - s));
     others.into_iter().find_map(|(s, e)| {
-        let o = oscillation(&error[s..e], (s, e));
+        let o = oscillation((s, e));
         (o.oscillating
             && o.periods_in_record.is_some_and(|p| p >= OTHER_HOLD_CYCLES)
             && o.cycle_share.is_some_and(|c| c >= CYCLE_SHARE_WHOLE))
@@ -260,7 +269,44 @@ fn weak_free_cycle(
 /// The oscillation of the control error `error` (sampled every `ts` s) over `stretch`.
 #[cfg(test)]
 fn oscillation(error: &[f64], ts: f64, stretch: (usize, usize)) -> Oscillation {
-    read_stretch(error, ts, stretch, Crossings::Plain)
+    read_stretch(error, ts, stretch, Crossings::Plain, &Basis::of(error))
+}
+
+/// What both readings of a stretch share: the error's autocorrelation (lags up to half the
+/// stretch), its noise and its amplitude.
+struct Basis {
+    acf: Vec<f64>,
+    noise: f64,
+    amp: f64,
+}
+
+impl Basis {
+    fn of(error: &[f64]) -> Self {
+        Self {
+            acf: detect::autocorrelation(error, error.len() / 2),
+            noise: crate::detect::measurement_noise(error),
+            amp: amplitude(error),
+        }
+    }
+}
+
+/// The bases of the stretches read so far: the reading through the band visits the stretches
+/// the plain reading did.
+#[derive(Default)]
+struct Bases(Vec<((usize, usize), Basis)>);
+
+impl Bases {
+    /// The basis of `error[s..e]`, computed once.
+    fn of(&mut self, error: &[f64], (s, e): (usize, usize)) -> &Basis {
+        let i = match self.0.iter().position(|(k, _)| *k == (s, e)) {
+            Some(i) => i,
+            None => {
+                self.0.push(((s, e), Basis::of(&error[s..e])));
+                self.0.len() - 1
+            }
+        };
+        &self.0[i].1
+    }
 }
 
 /// The oscillation of `error` over `stretch`, its crossings read as `crossings` says.
@@ -269,16 +315,16 @@ fn read_stretch(
     ts: f64,
     stretch: (usize, usize),
     crossings: Crossings,
+    basis: &Basis,
 ) -> Oscillation {
-    let acf = detect::autocorrelation(error, error.len() / 2);
+    let Basis { acf, noise, amp } = basis;
+    let (noise, amp) = (*noise, *amp);
     let regularity = match crossings {
-        Crossings::Plain => detect::regularity_of(&acf, ts),
+        Crossings::Plain => detect::regularity_of(acf, ts),
         Crossings::Banded => {
-            detect::regularity_banded(&acf, ts, CROSSING_BAND / (error.len() as f64).sqrt())
+            detect::regularity_banded(acf, ts, CROSSING_BAND / (error.len() as f64).sqrt())
         }
     };
-    let noise = crate::detect::measurement_noise(error);
-    let amp = amplitude(error);
     let period = regularity.period;
     let omega = period.map_or(
         2.0 * std::f64::consts::PI / (error.len() as f64 * ts),
@@ -293,7 +339,7 @@ fn read_stretch(
     };
     let iae = detect::iae_count(error, ts, &settings);
     let periods = period.map(|p| error.len() as f64 * ts / p);
-    let cycle_share = period.and_then(|p| cycle_share(&acf, error.len(), p / ts));
+    let cycle_share = period.and_then(|p| cycle_share(acf, error.len(), p / ts));
     // an oscillation that stands out of the noise, found by either detector (a regular period
     // stands out of noise at a smaller amplitude than a count of large areas)
     let above = regularity.oscillating && amp > REGULAR_AMPLITUDE * noise;
