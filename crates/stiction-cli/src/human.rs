@@ -7,10 +7,6 @@ use stiction_core::diagnose::{BandSource, Diagnosis, Verdict, Vote};
 /// Why a weak cycle (`Oscillation::weak_cycle`) counts, for the oscillation line.
 const WEAK_CYCLE: &str = "its half periods clear 1.5 noise standard deviations, not 3, and its period wanders as a limit cycle's does beside noise";
 
-/// How a period read through the autocorrelation's noise band (`Oscillation::through_noise_band`)
-/// was read, for the oscillation line.
-const THROUGH_NOISE_BAND: &str = "its period wanders: read with the autocorrelation's zero crossings taken through its noise band";
-
 fn band_source(s: BandSource) -> &'static str {
     match s {
         BandSource::Valve => "from the recorded valve position",
@@ -187,11 +183,7 @@ fn record(d: &Diagnosis) {
                 (true, false, false) => "yes".to_string(),
                 _ => "no".to_string(),
             },
-            if o.oscillating && o.through_noise_band {
-                format!(" ({THROUGH_NOISE_BAND})")
-            } else {
-                String::new()
-            },
+            o.reading_words().map_or(String::new(), |w| format!(" ({w})")),
             o.period.map_or("-".into(), |p| format!("{p:.1} s")),
             o.regularity.regularity,
             o.regularity.threshold,

@@ -168,6 +168,7 @@ pub(crate) fn regularity_banded(acf: &[f64], ts: f64, band: f64) -> Regularity {
     regularity_from(crossings, ts)
 }
 
+/// Thornhill's regularity from the autocorrelation's zero crossings (lags, in samples).
 fn regularity_from(mut crossings: Vec<f64>, ts: f64) -> Regularity {
     // Thornhill et al. use the first crossings only: deep into the lags the autocorrelation of
     // a noisy record wanders around zero and adds crossings that are not the oscillation's

@@ -110,6 +110,16 @@ pub struct Oscillation {
     pub through_noise_band: bool,
 }
 
+impl Oscillation {
+    /// How the period was read, in words, for an oscillation found through the noise band
+    /// ([`Oscillation::through_noise_band`]); `None` otherwise.
+    pub fn reading_words(&self) -> Option<&'static str> {
+        (self.oscillating && self.through_noise_band).then_some(
+            "its period wanders: read with the autocorrelation's zero crossings taken through its noise band",
+        )
+    }
+}
+
 /// Where the band in the verdict comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

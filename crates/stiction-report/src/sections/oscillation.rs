@@ -5,11 +5,8 @@ use super::*;
 pub fn oscillation(d: &Diagnosis) -> Option<Vec<KvRow>> {
     let o = d.oscillation.as_ref()?;
     let r = &o.regularity;
-    Some(vec![
-        kv(
-            "Oscillating",
-            if o.oscillating && o.weak_cycle {
-                format!(
+    let said = if o.oscillating && o.weak_cycle {
+        format!(
                     "yes: a weak cycle, regular and 1.5 to 3 noise standard deviations high; its period wanders as a limit cycle's does beside noise (one that kept a clock's time would be an input's){}",
                     if o.across_setpoint_steps {
                         "; across the setpoint's steps (no hold is long enough)"
@@ -17,16 +14,20 @@ pub fn oscillation(d: &Diagnosis) -> Option<Vec<KvRow>> {
                         ""
                     }
                 )
-            } else if o.oscillating && o.across_setpoint_steps {
-                "yes: regular and above the noise, across the setpoint's steps (no hold is long enough)"
-                    .to_string()
-            } else if o.oscillating && o.through_noise_band {
-                "yes: above the noise, its period wandering (read with the autocorrelation's zero crossings taken through its noise band)"
-                    .to_string()
-            } else if o.oscillating {
-                "yes: regular and above the noise".to_string()
-            } else {
-                "no".into()
+    } else if o.oscillating && o.across_setpoint_steps {
+        "yes: regular and above the noise, across the setpoint's steps (no hold is long enough)"
+            .to_string()
+    } else if o.oscillating {
+        "yes: regular and above the noise".to_string()
+    } else {
+        "no".into()
+    };
+    Some(vec![
+        kv(
+            "Oscillating",
+            match o.reading_words() {
+                Some(w) => format!("{said} ({w})"),
+                None => said,
             },
         ),
         kv("Period", o.period.map_or("–".into(), duration)),
