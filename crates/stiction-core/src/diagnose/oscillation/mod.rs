@@ -151,8 +151,8 @@ pub const CROSSING_BAND: f64 = 1.0;
 /// called `stiction`, no look-alike more (one aggressive tuning moved from `insufficient_data` to
 /// `no_stiction`); read through the band on each stretch that showed no cycle (before the other
 /// holds were tried), a band of 0.5 standard errors found the same 8 but lost 2 sticky valves and
-/// called 2 look-alikes `stiction`, one of 2 standard errors 6 more, 1 fewer and one look-alike; without the
-/// share, the same 8 and a load's steps called `stiction` (a share of 0.006) and four
+/// called 2 look-alikes `stiction`, one of 2 standard errors 6 more, 1 fewer and one look-alike;
+/// without the share, the same 8 and a load's steps called `stiction` (a share of 0.006) and four
 /// look-alikes moved from `insufficient_data` to `undetermined` (shares under 0.03), where the
 /// sticky valves found hold 0.06 to 0.32. Checked after on draws 4-7 and both benchmark sets
 /// (4,560 loops): 9 more sticky valves called `stiction` (3 of the routine benchmark's), and two
