@@ -128,16 +128,19 @@ pub fn regularity(error: &[f64], ts: f64) -> Regularity {
 
 /// [`regularity`] from the error's autocorrelation for lags up to half its length.
 pub(crate) fn regularity_of(acf: &[f64], ts: f64) -> Regularity {
-    // zero crossings, interpolated between lags
-    let mut crossings = Vec::new();
-    for k in 1..acf.len() {
-        let (a, b) = (acf[k - 1], acf[k]);
-        if (a > 0.0 && b <= 0.0) || (a < 0.0 && b >= 0.0) {
-            let frac = if a != b { a / (a - b) } else { 0.0 };
-            crossings.push((k - 1) as f64 + frac);
-        }
-    }
+    let crossings = (1..acf.len())
+        .filter_map(|k| zero_crossing(acf, k))
+        .collect();
     regularity_from(crossings, ts)
+}
+
+/// The zero crossing of the autocorrelation between lags `k - 1` and `k`, interpolated, if any.
+fn zero_crossing(acf: &[f64], k: usize) -> Option<f64> {
+    let (a, b) = (acf[k - 1], acf[k]);
+    ((a > 0.0 && b <= 0.0) || (a < 0.0 && b >= 0.0)).then(|| {
+        let frac = if a != b { a / (a - b) } else { 0.0 };
+        (k - 1) as f64 + frac
+    })
 }
 
 /// [`regularity_of`] with the zero crossings read through a band of `band` either side of zero:
@@ -152,11 +155,8 @@ pub(crate) fn regularity_banded(acf: &[f64], ts: f64, band: f64) -> Regularity {
     let mut pending: Vec<f64> = Vec::new();
     let mut above = true;
     for k in 1..acf.len() {
-        let (a, b) = (acf[k - 1], acf[k]);
-        if (a > 0.0 && b <= 0.0) || (a < 0.0 && b >= 0.0) {
-            let frac = if a != b { a / (a - b) } else { 0.0 };
-            pending.push((k - 1) as f64 + frac);
-        }
+        pending.extend(zero_crossing(acf, k));
+        let b = acf[k];
         if (above && b < -band) || (!above && b > band) {
             if !pending.is_empty() {
                 crossings.push(pending.iter().sum::<f64>() / pending.len() as f64);

@@ -131,7 +131,7 @@ pub(super) fn of_record(error: &[f64], sp: Option<&[f64]>, ts: f64) -> Oscillati
 
 /// How the autocorrelation's zero crossings are read for the periods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Crossings {
+enum Crossings {
     /// Every crossing (Thornhill's reading).
     Plain,
     /// Through a band of [`CROSSING_BAND`] standard errors either side of zero
