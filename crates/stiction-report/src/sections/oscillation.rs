@@ -7,13 +7,13 @@ pub fn oscillation(d: &Diagnosis) -> Option<Vec<KvRow>> {
     let r = &o.regularity;
     let said = if o.oscillating && o.weak_cycle {
         format!(
-                    "yes: a weak cycle, regular and 1.5 to 3 noise standard deviations high; its period wanders as a limit cycle's does beside noise (one that kept a clock's time would be an input's){}",
-                    if o.across_setpoint_steps {
-                        "; across the setpoint's steps (no hold is long enough)"
-                    } else {
-                        ""
-                    }
-                )
+            "yes: a weak cycle, regular and 1.5 to 3 noise standard deviations high; its period wanders as a limit cycle's does beside noise (one that kept a clock's time would be an input's){}",
+            if o.across_setpoint_steps {
+                "; across the setpoint's steps (no hold is long enough)"
+            } else {
+                ""
+            }
+        )
     } else if o.oscillating && o.across_setpoint_steps {
         "yes: regular and above the noise, across the setpoint's steps (no hold is long enough)"
             .to_string()
