@@ -287,6 +287,15 @@ fn without_votes(
                 .to_string(),
         );
     }
+    if model_flag(families, |m| {
+        m.cycle_shape.as_ref().is_some_and(|c| c.foreign())
+    }) {
+        return (
+            Verdict::Undetermined,
+            "the loop moves, but only the closed-loop fit could judge it, and the valve it fits would give PV's regular cycle a shape PV does not have (steps' harmonics in a sinusoidal cycle): a cycle OP does not drive, as a sine added to PV, gives that; no other family votes"
+                .to_string(),
+        );
+    }
     if model_flag(families, |m| m.fit_mirrors_controller) {
         return (
             Verdict::Undetermined,

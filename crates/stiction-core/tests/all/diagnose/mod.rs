@@ -7,7 +7,8 @@ mod shape;
 mod thorough;
 
 use stiction_core::diagnose::evidence::model::{
-    CYCLE_CANCELLED_STICTION, FORCED_REGULARITY, SIGNIFICANCE_NONE, SIGNIFICANCE_STICTION,
+    CYCLE_CANCELLED_STICTION, FORCED_REGULARITY, FOREIGN_SHAPE, SIGNIFICANCE_NONE,
+    SIGNIFICANCE_STICTION,
 };
 use stiction_core::diagnose::evidence::stick_slip::PV_BAND_SIGMAS;
 use stiction_core::diagnose::{

@@ -264,6 +264,66 @@ fn a_band_that_only_fits_a_clock_regular_cycle_is_no_vote() {
 }
 
 #[test]
+fn a_band_whose_steps_the_recorded_cycle_lacks_is_no_vote() {
+    // loop L000662 of the batch benchmark's mix: a healthy valve on FOPTD (1, 30 s, 5 s) under PI
+    // (1, 30 s), PV noise 0.3, a sine of amplitude 1 and period 178 s added to PV, the setpoint
+    // constant. The fitted valve (a band about OP's whole swing) slips twice a period in step with
+    // the sine and explains far more of PV than a valve that follows OP (test ratio in the
+    // hundreds), but the PV it gives carries its steps' harmonics and the recorded PV, a sine in
+    // noise, does not: no vote, and the loop is not called sticky.
+    let l = run(0.0, |cl| {
+        cl.process = Process::Foptd {
+            k: 1.0,
+            tau: 30.0,
+            delay: 5.0,
+        };
+        cl.pi.kc = 1.0;
+        cl.pi.ti = 30.0;
+        cl.noise = 0.3;
+        cl.seed = 90441349846404486;
+        cl.disturbance = Some(Signal::Sine {
+            amplitude: 1.0,
+            period: 177.62339365848646,
+            offset: 0.0,
+        });
+    });
+    let d = diagnose(&record(&l), &quick()).unwrap();
+    let model = model_family(&d);
+    let m = model.model.as_ref().unwrap();
+    assert!(m.significance >= SIGNIFICANCE_STICTION, "{}", model.note);
+    let shape = m
+        .cycle_shape
+        .as_ref()
+        .expect("the cycle's shape is checked");
+    assert!(shape.foreign(), "{shape:?}");
+    assert!(
+        shape.fit_harmonics >= FOREIGN_SHAPE * shape.pv_harmonics,
+        "{shape:?}"
+    );
+    assert_eq!(model.vote, Vote::Undetermined, "{}", model.note);
+    assert_eq!(model.leans, None, "{}", model.note);
+    assert!(
+        model.note.contains("a shape PV does not have"),
+        "{}",
+        model.note
+    );
+    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    // a sticky valve's own limit cycle carries the harmonics its fit gives: the vote stands
+    // (routine-c-0171, a Stenman valve cycling every 59 s: the fit's PV 0.031, the recorded 0.012,
+    // the largest ratio of the calibration set's sticky valves)
+    let d = judge_catalogue("routine-c-0171");
+    let model = model_family(&d);
+    let shape = model.model.as_ref().unwrap().cycle_shape.as_ref();
+    assert!(
+        shape.is_some_and(|s| !s.foreign()),
+        "{shape:?}: {}",
+        model.note
+    );
+    assert_eq!(model.vote, Vote::Stiction, "{}", model.note);
+    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+}
+
+#[test]
 fn a_fit_that_mirrors_the_controller_casts_no_stiction_vote() {
     // routine-c-0490 of the plant catalogue (calibration set): a healthy pressure valve whose
     // load steps OP does not explain; the linear fit reads PV from OP through the controller's own

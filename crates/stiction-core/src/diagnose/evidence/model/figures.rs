@@ -1,7 +1,8 @@
 //! The fits' figures as the result reports them, and the words of the family's note on them.
 
 use super::{
-    loop_gain, unprovoked, CycleCancelled, Levels, LevelsEvidence, Unprovoked, CALIBRATION,
+    loop_gain, unprovoked, CycleCancelled, CycleShape, Levels, LevelsEvidence, Unprovoked,
+    CALIBRATION,
 };
 use crate::diagnose::evidence::Context;
 use crate::identify::Structure;
@@ -98,6 +99,11 @@ pub struct ModelEvidence {
     /// [`super::MAX_UNPROVOKED_SHARE`] or more of OP's travel (a feed-forward, an override, an operator).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub op_moved_elsewhere: bool,
+    /// On a regular cycle where the fit voted stiction, the harmonics of the cycle in the PV the
+    /// fitted valve gives and in the recorded PV ([`CycleShape`]); the vote was withdrawn where the
+    /// fit's shape is foreign to the record.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle_shape: Option<CycleShape>,
     /// The lag's bound (samples), when the lag reached it and the comparison over a third of it
     /// ([`super::BOUND_LAG_DIVISOR`]), which `lag` then gives, had the higher test ratio.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -202,5 +208,6 @@ pub(super) fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) 
         fit_mirrors_controller: false,
         op_moved_elsewhere: false,
         lag_bound: ctx.lag_bound,
+        cycle_shape: None,
     }
 }

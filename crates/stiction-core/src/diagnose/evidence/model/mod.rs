@@ -24,6 +24,7 @@
 
 mod bound;
 mod cycle;
+mod cycle_shape;
 mod figures;
 mod levels;
 mod unprovoked;
@@ -35,6 +36,7 @@ use cycle::clock_regular;
 pub use cycle::{
     CycleCancelled, CYCLE_CANCELLED_STICTION, FORCED_CROSSINGS, FORCED_GAIN, FORCED_REGULARITY,
 };
+pub use cycle_shape::{CycleShape, FIT_HARMONICS, FOREIGN_SHAPE};
 pub use figures::ModelEvidence;
 use figures::{fits_words, model_evidence};
 pub use levels::{LevelsEvidence, LEVELS_STICTION, MAX_UNRECORDED};
@@ -183,7 +185,9 @@ impl EvidenceFamily for Model {
              or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
              of the PV's variation above its noise; no stiction vote on a loop that does not limit-cycle when the fitted process and the identified PI \
              make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller); PV's changes are compared over 1.5 response times, \
-             at most a tenth of the record, and where the lag reaches that bound also over a third of it (the higher ratio kept)",
+             at most a tenth of the record, and where the lag reaches that bound also over a third of it (the higher ratio kept); \
+             no stiction vote on a regular cycle (regularity {LIMIT_CYCLE_REGULARITY} or more) where the fitted valve gives PV harmonics of at least \
+             {FIT_HARMONICS} of the cycle's power and {FOREIGN_SHAPE} times those of the recorded PV (a shape PV does not have)",
             100.0 * MIN_EXPLAINED
         );
         let threshold = if ctx.req.thorough {
@@ -242,6 +246,14 @@ impl EvidenceFamily for Model {
                 );
                 (vote, strength) = (Vote::Undetermined, 0.0);
                 evidence.gain_in_a_clock_regular_cycle = true;
+            }
+        }
+        // a regular cycle: does the fitted valve give PV the cycle's shape?
+        if vote == Vote::Stiction {
+            evidence.cycle_shape = CycleShape::of(ctx, f);
+            if let Some(shape) = evidence.cycle_shape.as_ref().filter(|c| c.foreign()) {
+                why = format!("{why}; {}", shape.words());
+                (vote, strength) = (Vote::Undetermined, 0.0);
             }
         }
         if vote != Vote::Stiction && levels.explained >= MIN_EXPLAINED {
