@@ -97,19 +97,26 @@ pub fn window_count(op: &[f64], pv: &[f64], k: usize) -> (usize, usize) {
 }
 
 /// The stick-then-jump check: stretches where PV stays within [`STICK_BAND_SIGMAS`] of where
-/// it began while OP travels at least [`STICK_OP_SIGMAS`] of its noise, mostly one way, ended by
-/// PV leaving the band in OP's direction (a process of positive gain, as the catalogue's).
+/// it began (the median of its first three samples) while OP travels at least
+/// [`STICK_OP_SIGMAS`] of its noise, mostly one way, ended by PV leaving the band (two samples in
+/// a row) in OP's direction (a process of positive gain, as the catalogue's).
 pub fn stick_jump_count(op: &[f64], pv: &[f64]) -> usize {
     let (s_op, s_pv) = (noise_sd(op), noise_sd(pv));
     let n = op.len().min(pv.len());
     let (mut i, mut count) = (0, 0);
-    while i + 1 < n {
-        let anchor = pv[i];
+    while i + 3 < n {
+        // where the stick began: the median of its first three samples, so one noisy sample
+        // does not set the band
+        let mut first = [pv[i], pv[i + 1], pv[i + 2]];
+        first.sort_by(f64::total_cmp);
+        let anchor = first[1];
+        let outside = |k: usize| (pv[k] - anchor).abs() > STICK_BAND_SIGMAS * s_pv;
+        // PV leaves the band for good (two samples in a row), not on one noisy sample
         let mut j = i + 1;
-        while j < n && (pv[j] - anchor).abs() <= STICK_BAND_SIGMAS * s_pv {
+        while j + 1 < n && !(outside(j) && outside(j + 1)) {
             j += 1;
         }
-        if j >= n {
+        if j + 1 >= n {
             break;
         }
         let stick = &op[i..j];
@@ -136,19 +143,9 @@ mod tests {
     use super::*;
 
     fn noise(n: usize, sd: f64, seed: u64) -> Vec<f64> {
-        // a small deterministic generator: sums of uniforms, near normal
-        let mut s = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+        let mut rng = stiction_core::rng::seeded(seed);
         (0..n)
-            .map(|_| {
-                let mut v = 0.0;
-                for _ in 0..12 {
-                    s = s
-                        .wrapping_mul(6364136223846793005)
-                        .wrapping_add(1442695040888963407);
-                    v += (s >> 11) as f64 / (1u64 << 53) as f64;
-                }
-                sd * (v - 6.0)
-            })
+            .map(|_| sd * stiction_core::rng::gaussian(&mut rng))
             .collect()
     }
 

@@ -29,8 +29,9 @@ pub fn header(draws: u8) -> String {
          {PV_TRAVEL_SIGMAS} of its own and PV stays within {PV_BAND_SIGMAS} of its window's mean (noise from first \
          differences, robustly);\n\
          - **stick then jump** (Kano-style): stretches where PV stays within {STICK_BAND_SIGMAS} noise standard deviations \
-         of where the stretch began while OP travels at least {STICK_OP_SIGMAS} of its own, mostly one way (its range at \
-         most {MONOTONE} times its net travel), ended by PV leaving the band in OP's direction.\n\n\
+         of where the stretch began (the median of its first three samples) while OP travels at least {STICK_OP_SIGMAS} of \
+         its own, mostly one way (its range at most {MONOTONE} times its net travel), ended by PV leaving the band (two \
+         samples in a row) in OP's direction.\n\n\
          Each gives a count per record. Read naively, one is enough (any window fires). Calibrated as `diagnose`'s \
          thresholds were, on a rate (the share of the record's windows that fire; sticks per 1,000 samples, since records \
          differ in length), the threshold is the smallest rate at which the test calls no more of the not-sticky loops of the \
