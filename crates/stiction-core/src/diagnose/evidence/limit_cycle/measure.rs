@@ -156,7 +156,7 @@ fn unexplained_share(
 
 /// How many harmonics (up to 5) of a cycle of `samples_per_cycle` samples lie, with their bands of
 /// ±0.3 of the fundamental, below the Nyquist frequency (as `harmonic_distortion` requires).
-pub(super) fn measurable_harmonics(samples_per_cycle: f64) -> usize {
+pub(crate) fn measurable_harmonics(samples_per_cycle: f64) -> usize {
     ((0.5 * samples_per_cycle - 0.3).floor().max(0.0) as usize).min(5)
 }
 

@@ -30,7 +30,7 @@
 //! look-alikes' stiction votes at or under 3 % per class; never on the ISDB.
 
 mod measure;
-pub(crate) use measure::share_of_cycles;
+pub(crate) use measure::{measurable_harmonics, share_of_cycles};
 mod vote;
 
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};

@@ -22,6 +22,7 @@
 //! the 108 loops no verdict moves (docs/accuracy-history.md).
 
 use super::{Context, LIMIT_CYCLE_REGULARITY};
+use crate::diagnose::evidence::limit_cycle::{measurable_harmonics, MIN_HARMONICS};
 use crate::diagnose::evidence::shape::SINUSOIDAL_HARMONICS;
 use crate::quantify::FitComparison;
 use crate::spectral::harmonic_distortion;
@@ -64,8 +65,8 @@ impl CycleShape {
             return None;
         }
         let samples = period / ctx.req.ts;
-        let count = ((0.5 * samples - 0.3).floor().max(0.0) as usize).min(5);
-        if count < 3 {
+        let count = measurable_harmonics(samples);
+        if count < MIN_HARMONICS {
             return None;
         }
         Some(Self {
