@@ -84,7 +84,7 @@ impl CycleShape {
     }
 
     /// A clause for the family's note, where the shape is foreign.
-    pub(super) fn words(&self) -> String {
+    pub fn words(&self) -> String {
         format!(
             "but on the regular cycle of {:.0} s the fitted valve would give PV harmonics of {:.3} of the cycle's power and the recorded PV carries {:.4}: \
              the band reproduces the cycle's timing with a shape PV does not have (a cycle OP does not drive, as a sine added to PV, gives that), so this is no vote",
@@ -93,6 +93,21 @@ impl CycleShape {
             self.pv_harmonics.max(0.0)
         )
     }
+}
+
+/// The cycle's shape of a stiction vote's fit, kept in `evidence`; the words for the family's
+/// note where the shape is foreign (the vote is then withdrawn).
+pub(super) fn checked(
+    ctx: &Context,
+    f: &FitComparison,
+    evidence: &mut super::ModelEvidence,
+) -> Option<String> {
+    evidence.cycle_shape = CycleShape::of(ctx, f);
+    evidence
+        .cycle_shape
+        .as_ref()
+        .filter(|c| c.foreign())
+        .map(CycleShape::words)
 }
 
 #[cfg(test)]

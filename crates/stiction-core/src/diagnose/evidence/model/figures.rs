@@ -2,7 +2,8 @@
 
 use super::{
     loop_gain, unprovoked, CycleCancelled, CycleShape, Levels, LevelsEvidence, Unprovoked,
-    CALIBRATION,
+    CALIBRATION, CYCLE_CANCELLED_STICTION, FIT_HARMONICS, FOREIGN_SHAPE, LEVELS_STICTION,
+    LIMIT_CYCLE_REGULARITY, MIN_EXPLAINED, MIN_LOOP_GAIN, SIGNIFICANCE_NONE, SIGNIFICANCE_STICTION,
 };
 use crate::diagnose::evidence::Context;
 use crate::identify::Structure;
@@ -209,5 +210,30 @@ pub(super) fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) 
         op_moved_elsewhere: false,
         lag_bound: ctx.lag_bound,
         cycle_shape: None,
+    }
+}
+
+/// The family's threshold, in words (with the levels test's where the request is `thorough`).
+pub(super) fn threshold_words(thorough: bool) -> String {
+    let threshold = format!(
+        "stiction when the improvement, held against the stiction fit's residual per independent change, reaches {SIGNIFICANCE_STICTION} \
+         (about the 95th percentile of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); on a loop that limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more) and stays under it, or on another oscillating loop where it finds none, the same test on \
+         changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}; none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles \
+         or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
+         of the PV's variation above its noise; no stiction vote on a loop that does not limit-cycle when the fitted process and the identified PI \
+         make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller); PV's changes are compared over 1.5 response times, \
+         at most a tenth of the record, and where the lag reaches that bound also over a third of it (the higher ratio kept); \
+         no stiction vote on a regular cycle (regularity {LIMIT_CYCLE_REGULARITY} or more) where the fitted valve gives PV harmonics of at least \
+         {FIT_HARMONICS} of the cycle's power and {FOREIGN_SHAPE} times those of the recorded PV (a shape PV does not have)",
+        100.0 * MIN_EXPLAINED
+    );
+    if thorough {
+        format!(
+            "{threshold}; or the levels test's ratio (the best Stenman valve against OP on PV's levels) reaches {LEVELS_STICTION} \
+             (about the 98th percentile of simulated healthy loops), unless OP explains under {:.0} %",
+            100.0 * MIN_EXPLAINED
+        )
+    } else {
+        threshold
     }
 }

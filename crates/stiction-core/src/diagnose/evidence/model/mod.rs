@@ -38,7 +38,7 @@ pub use cycle::{
 };
 pub use cycle_shape::{CycleShape, FIT_HARMONICS, FOREIGN_SHAPE};
 pub use figures::ModelEvidence;
-use figures::{fits_words, model_evidence};
+use figures::{fits_words, model_evidence, threshold_words};
 pub use levels::{LevelsEvidence, LEVELS_STICTION, MAX_UNRECORDED};
 pub use unprovoked::{
     robust_sd, unprovoked, Unprovoked, MAX_UNPROVOKED_SHARE, QUIET_SIGMAS, STEP_SIGMAS,
@@ -178,27 +178,7 @@ impl EvidenceFamily for Model {
     fn evaluate(&self, ctx: &Context) -> FamilyEvidence {
         let statistic =
             "improvement of the fit with stiction over the linear loop, share of the PV's variance above its noise";
-        let threshold = format!(
-            "stiction when the improvement, held against the stiction fit's residual per independent change, reaches {SIGNIFICANCE_STICTION} \
-             (about the 95th percentile of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); on a loop that limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more) and stays under it, or on another oscillating loop where it finds none, the same test on \
-             changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}; none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles \
-             or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
-             of the PV's variation above its noise; no stiction vote on a loop that does not limit-cycle when the fitted process and the identified PI \
-             make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller); PV's changes are compared over 1.5 response times, \
-             at most a tenth of the record, and where the lag reaches that bound also over a third of it (the higher ratio kept); \
-             no stiction vote on a regular cycle (regularity {LIMIT_CYCLE_REGULARITY} or more) where the fitted valve gives PV harmonics of at least \
-             {FIT_HARMONICS} of the cycle's power and {FOREIGN_SHAPE} times those of the recorded PV (a shape PV does not have)",
-            100.0 * MIN_EXPLAINED
-        );
-        let threshold = if ctx.req.thorough {
-            format!(
-                "{threshold}; or the levels test's ratio (the best Stenman valve against OP on PV's levels) reaches {LEVELS_STICTION} \
-                 (about the 98th percentile of simulated healthy loops), unless OP explains under {:.0} %",
-                100.0 * MIN_EXPLAINED
-            )
-        } else {
-            threshold
-        };
+        let threshold = threshold_words(ctx.req.thorough);
         let Some(f) = &ctx.fits else {
             return FamilyEvidence::abstains(
                 Family::Model,
@@ -249,12 +229,11 @@ impl EvidenceFamily for Model {
             }
         }
         // a regular cycle: does the fitted valve give PV the cycle's shape?
-        if vote == Vote::Stiction {
-            evidence.cycle_shape = CycleShape::of(ctx, f);
-            if let Some(shape) = evidence.cycle_shape.as_ref().filter(|c| c.foreign()) {
-                why = format!("{why}; {}", shape.words());
-                (vote, strength) = (Vote::Undetermined, 0.0);
-            }
+        if let Some(w) = (vote == Vote::Stiction)
+            .then(|| cycle_shape::checked(ctx, f, &mut evidence))
+            .flatten()
+        {
+            (vote, strength, why) = (Vote::Undetermined, 0.0, format!("{why}; {w}"));
         }
         if vote != Vote::Stiction && levels.explained >= MIN_EXPLAINED {
             if let Some(s) = test.stiction_strength() {
