@@ -209,7 +209,7 @@ fn summary(md: &mut String, bench: &[Judged], methods: &[Method]) {
         .iter()
         .filter(|j| j.truth == Truth::NotSticky)
         .collect();
-    let classes = look_alikes(bench);
+    let classes = classes(bench, |j| j.truth == Truth::NotSticky);
     let _ = writeln!(
         md,
         "Benchmark set: {} sticky and {} not-sticky loops.\n\n\
@@ -237,9 +237,10 @@ fn summary(md: &mut String, bench: &[Judged], methods: &[Method]) {
     md.push('\n');
 }
 
-fn look_alikes(bench: &[Judged]) -> Vec<LoopClass> {
+/// The classes of the loops `keep` keeps, in the order they first come.
+fn classes(bench: &[Judged], keep: impl Fn(&Judged) -> bool) -> Vec<LoopClass> {
     let mut classes: Vec<LoopClass> = Vec::new();
-    for j in bench.iter().filter(|j| j.truth == Truth::NotSticky) {
+    for j in bench.iter().filter(|j| keep(j)) {
         if !classes.contains(&j.class) {
             classes.push(j.class);
         }
@@ -248,12 +249,7 @@ fn look_alikes(bench: &[Judged]) -> Vec<LoopClass> {
 }
 
 fn by_class(md: &mut String, bench: &[Judged], methods: &[Method]) {
-    let mut classes: Vec<LoopClass> = Vec::new();
-    for j in bench.iter().filter(|j| j.truth != Truth::BacklashOnly) {
-        if !classes.contains(&j.class) {
-            classes.push(j.class);
-        }
-    }
+    let classes = classes(bench, |j| j.truth != Truth::BacklashOnly);
     let _ = write!(md, "Flagged, by class:\n\n| class | truth | loops |");
     for m in methods {
         let _ = write!(md, " {} |", m.name);
