@@ -123,6 +123,17 @@ fn evidence(d: &Diagnosis) {
             f.note
         );
     }
+    if let Some(c) = &d.combined {
+        println!(
+            "    {:<24} {:<13} probability of a sticky valve {:.2} from the families' statistics read together (stiction from {:.2}; \
+             these trees only ever add a stiction verdict); towards a sticky valve most: {}",
+            "statistics combined",
+            if c.decided { "stiction" } else { "no vote" },
+            c.probability,
+            c.threshold,
+            c.leading()
+        );
+    }
     if !d.indices.is_empty() {
         println!("  shape indices (oscillating stretch):");
         for i in &d.indices {

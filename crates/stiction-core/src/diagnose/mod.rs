@@ -15,6 +15,7 @@
 
 mod band;
 mod bridge;
+pub mod combined;
 pub mod evidence;
 mod gates;
 pub mod oscillation;
@@ -53,6 +54,8 @@ struct Judged {
     indices: Vec<Index>,
     oscillation: Osc,
     decision: verdict::Decision,
+    /// The families' statistics read together ([`combined`]).
+    combined: Option<combined::CombinedEvidence>,
     fits: Option<crate::quantify::FitComparison>,
     /// Without a recorded setpoint, the setpoint read off OP and PV ([`setpoint`]).
     setpoint: Option<setpoint::Inferred>,
@@ -122,6 +125,20 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
             decision = verdict::decide(&families, &motion);
         }
     }
+    let mut combined = combined::CombinedEvidence::of(&combined::features::Stretch {
+        families: &families,
+        oscillation: &ctx.oscillation,
+        op_noise: ctx.op_noise,
+        ts: req.ts,
+        samples: r.op.len(),
+    });
+    if let Some(c) = combined.as_mut() {
+        if c.decides(decision.verdict, &families) {
+            c.decided = true;
+            decision = verdict::decided_by_combination(decision, c, &families, &motion);
+        }
+        decision.evidence.push(c.line());
+    }
     let Context {
         oscillation,
         indices,
@@ -133,6 +150,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         indices: indices.into_inner().unwrap_or_default(),
         oscillation,
         decision,
+        combined,
         fits,
         setpoint: inferred,
     }
@@ -222,6 +240,7 @@ pub fn diagnose_checked(
         quality,
         oscillation: None,
         families: Vec::new(),
+        combined: None,
         indices: Vec::new(),
         reach: None,
         band: None,
@@ -257,6 +276,7 @@ pub fn diagnose_checked(
     d.evidence = j.decision.evidence;
     d.next_step = j.decision.next_step;
     d.families = j.families;
+    d.combined = j.combined;
     d.indices = j.indices;
     d.reach = reach::of(&d, sub.op, req);
     let mut osc = j.oscillation;

@@ -279,6 +279,10 @@ pub struct Diagnosis {
     pub oscillation: Option<Oscillation>,
     /// The families of evidence, each with its value, threshold and vote.
     pub families: Vec<FamilyEvidence>,
+    /// The families' statistics read together (trained trees; they only ever add a `stiction`
+    /// verdict): absent on a record too short or too still to judge.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub combined: Option<super::combined::CombinedEvidence>,
     /// The shape family's indices (on an oscillating stretch).
     pub indices: Vec<Index>,
     /// The bands a record like this one shows and hides, from OP's noise (on every judged

@@ -32,7 +32,7 @@ pub struct Evidence {
 }
 
 pub fn evidence(d: &Diagnosis) -> Evidence {
-    let families = d
+    let mut families: Vec<FamilyRow> = d
         .families
         .iter()
         .map(|f| FamilyRow {
@@ -44,6 +44,23 @@ pub fn evidence(d: &Diagnosis) -> Evidence {
             note: f.note.clone(),
         })
         .collect();
+    if let Some(c) = &d.combined {
+        families.push(FamilyRow {
+            family: "statistics combined",
+            value: num(c.probability),
+            vote: vote_chip(if c.decided {
+                Vote::Stiction
+            } else {
+                Vote::Undetermined
+            }),
+            statistic: "probability of a sticky valve from the families' statistics read together (trained trees)".into(),
+            threshold: format!(
+                "stiction from {:.2}; never a vote against stiction (trained on simulated loops only)",
+                c.threshold
+            ),
+            note: format!("towards a sticky valve most: {}", c.leading()),
+        });
+    }
     let indices = d
         .indices
         .iter()

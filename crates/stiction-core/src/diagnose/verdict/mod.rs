@@ -270,6 +270,23 @@ pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
     }
 }
 
+/// The rules' decision turned to `stiction` by the families' statistics read together.
+pub(super) fn decided_by_combination(
+    before: Decision,
+    combined: &super::combined::CombinedEvidence,
+    families: &[FamilyEvidence],
+    motion: &Motion,
+) -> Decision {
+    let confidence = Some(combined.probability);
+    Decision {
+        verdict: Verdict::Stiction,
+        confidence,
+        reason: Some(combined.reason(before.verdict)),
+        next_step: next_step(Verdict::Stiction, confidence, families, motion),
+        evidence: before.evidence,
+    }
+}
+
 /// The verdict and reason when no family votes: leaning evidence, a withdrawn fit, an
 /// oscillation nobody explains, or a record nobody could judge.
 fn without_votes(

@@ -1,0 +1,190 @@
+//! The families' statistics read together: gradient-boosted trees, trained on simulated loops
+//! of many kinds (the catalogue's calibration draws, routine and fast; never the ISDB), give the
+//! probability of a sticky valve from the 39 statistics the families report
+//! ([`features::NAMES`]). The verdict's rules read each family's vote and a few of its figures;
+//! the trees also read how the figures go together (a closed-loop fit's test ratio between its
+//! thresholds while the stick-slip episodes and the oscillation's amplitude say more), which
+//! finds sticky valves the rules leave `no_stiction` or `undetermined`.
+//!
+//! The trees only ever add a `stiction` verdict, and only from a probability calibrated to add
+//! few look-alikes: out of fold on their training loops, about one healthy loop in a hundred.
+//! They never take one away, never decide where the valve position is recorded, and never
+//! decide against stiction: a learned combination does not hold where the catalogue does not
+//! teach it (docs/accuracy-history.md, "A learned combination of the families' statistics": as
+//! the whole verdict it lost ISDB loops whose statistics the catalogue has no example of), so
+//! its low probabilities are no evidence. Where it decides, the verdict names the statistics that
+//! weighed most.
+
+pub mod features;
+mod forest;
+
+pub use forest::forest;
+
+use super::evidence::{Family, FamilyEvidence};
+use super::result::{Verdict, Vote};
+use serde::{Deserialize, Serialize};
+
+/// One statistic as the trees read it, and how much it moved their log-odds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Statistic {
+    /// Its name ([`features::NAMES`]).
+    pub name: String,
+    /// Its value as the trees read it (log-scaled ones on their log scale).
+    pub value: f64,
+    /// Its share of the trees' log-odds (Saabas' path contributions; positive: towards a sticky
+    /// valve).
+    pub contribution: f64,
+}
+
+/// What the trees found.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CombinedEvidence {
+    /// The trees' probability of a sticky valve.
+    pub probability: f64,
+    /// From this probability a verdict other than `stiction` becomes `stiction`.
+    pub threshold: f64,
+    /// Whether the trees turned the verdict to `stiction`.
+    pub decided: bool,
+    /// Every statistic read, in the trees' order.
+    pub statistics: Vec<Statistic>,
+    /// How the trees and the threshold were set.
+    pub calibration: String,
+}
+
+/// How many statistics the verdict's reason names.
+const NAMED: usize = 3;
+
+impl CombinedEvidence {
+    /// The trees' reading of one judged stretch; `None` without trained trees.
+    pub fn of(stretch: &features::Stretch) -> Option<Self> {
+        let forest = forest()?;
+        let x = features::of(stretch);
+        let reading = forest.read(&x)?;
+        Some(Self {
+            probability: reading.probability,
+            threshold: forest.threshold,
+            decided: false,
+            statistics: features::NAMES
+                .iter()
+                .zip(x)
+                .zip(reading.contributions)
+                .map(|((&(name, _), value), contribution)| Statistic {
+                    name: name.into(),
+                    value,
+                    contribution,
+                })
+                .collect(),
+            calibration: forest.calibration.clone(),
+        })
+    }
+
+    /// Whether the trees turn `verdict` to `stiction`: their probability reaches the threshold,
+    /// the rules did not already say `stiction` or find nothing to judge, and no recorded valve
+    /// position decided.
+    pub fn decides(&self, verdict: Verdict, families: &[FamilyEvidence]) -> bool {
+        let valve_voted = families
+            .iter()
+            .any(|f| f.family == Family::Valve && f.vote != Vote::Undetermined);
+        self.probability >= self.threshold
+            && matches!(verdict, Verdict::NoStiction | Verdict::Undetermined)
+            && !valve_voted
+    }
+
+    /// The verdict's reason when the trees decide.
+    pub fn reason(&self, before: Verdict) -> String {
+        format!(
+            "the families' statistics read together call the valve sticky: trees trained on simulated loops give a sticky valve a \
+             probability of {:.2} (stiction from {:.2}), most of all from {}; the rules alone said {}",
+            self.probability,
+            self.threshold,
+            self.leading(),
+            before.as_str()
+        )
+    }
+
+    /// The statistics that weighed most towards a sticky valve, in words with their values.
+    pub fn leading(&self) -> String {
+        let mut order: Vec<(usize, &Statistic)> = self.statistics.iter().enumerate().collect();
+        order.sort_by(|a, b| b.1.contribution.total_cmp(&a.1.contribution));
+        let words: Vec<String> = order
+            .iter()
+            .take(NAMED)
+            .filter(|(_, s)| s.contribution > 0.0)
+            .map(|&(i, s)| format!("{} ({})", features::NAMES[i].1, shown(s)))
+            .collect();
+        match words.as_slice() {
+            [] => "no single statistic".into(),
+            [one] => one.clone(),
+            [init @ .., last] => format!("{} and {last}", init.join(", ")),
+        }
+    }
+
+    /// One line for the evidence list.
+    pub fn line(&self) -> String {
+        format!(
+            "statistics combined: {} (probability of a sticky valve {:.2}; stiction from {:.2}; the trees only ever add a stiction verdict)",
+            if self.decided {
+                "stiction"
+            } else {
+                "no vote"
+            },
+            self.probability,
+            self.threshold
+        )
+    }
+}
+
+/// A statistic's value as a person reads it: votes as words, log-scaled ones back on their own
+/// scale.
+fn shown(s: &Statistic) -> String {
+    if s.name.ends_with("_vote") {
+        return match s.value {
+            v if v > 0.5 => "stiction".into(),
+            v if v < -0.5 => "none".into(),
+            _ => "undetermined".into(),
+        };
+    }
+    let logged = matches!(
+        s.name.as_str(),
+        "model_test_ratio"
+            | "model_correlation_span"
+            | "model_band_over_op_noise"
+            | "model_slip_band_over_op_noise"
+            | "stick_slip_episodes"
+            | "stick_slip_travel_over_op_noise"
+            | "stick_slip_quiet_stretches"
+            | "regularity"
+            | "periods_in_record"
+            | "amplitude_over_noise"
+            | "loop_harmonics"
+            | "loop_amplitude_change"
+            | "loop_phase_wander"
+            | "loop_describing_distance"
+            | "model_cycle_cancelled_ratio"
+    );
+    let v = if logged {
+        s.value.signum() * s.value.abs().exp_m1()
+    } else if matches!(s.name.as_str(), "log_ts" | "log_samples") {
+        s.value.exp()
+    } else {
+        s.value
+    };
+    format!("{}", Sig3(v))
+}
+
+/// Three significant figures.
+struct Sig3(f64);
+
+impl std::fmt::Display for Sig3 {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = self.0;
+        if v == 0.0 || !v.is_finite() {
+            return write!(f, "{v}");
+        }
+        let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+        write!(f, "{v:.digits$}")
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,149 @@
+#!/usr/bin/env python3
+"""Train the trees `diagnose` reads the families' statistics with (diagnose::combined).
+
+Not part of the tests (needs numpy and scikit-learn); the trees it writes are committed in
+crates/stiction-core/src/diagnose/combined/forest.json. It reads the JSON lines the plant
+benchmark writes (each loop's diagnosis carries `combined.statistics`, the 39 statistics the
+trees read, whatever trees are embedded), trains gradient-boosted trees to tell the sticky valves
+from the rest, sets the threshold from which they call a valve sticky, and writes the trees.
+
+Training loops: the catalogue's calibration sets and their further draws (routine and fast),
+never the benchmark sets, draws 4-7 (the held-out draws the accuracy history judges on) or the
+ISDB:
+
+    D=/tmp/combined; mkdir -p $D
+    cargo build --release -p stiction-core --example plant_benchmark
+    B=target/release/examples/plant_benchmark
+    for s in routine fast; do
+      $B --set $s --calibration --out $D/x.md --jsonl $D/$s-c.jsonl
+      for n in 1 2 3 $(seq 10 29); do $B --set $s --extra $n --out $D/x.md --jsonl $D/$s-x$n.jsonl; done
+    done
+    python3 -m venv $D/venv && $D/venv/bin/pip install numpy scikit-learn
+    $D/venv/bin/python scripts/train_combined.py crates/stiction-core/src/diagnose/combined/forest.json $D/*.jsonl
+
+The threshold: the lowest of 0.50, 0.55, ..., 0.95 at which, out of fold (five folds of the
+training loops), the trees would turn at most 0.5 % of the look-alikes (healthy valves of every
+kind) to `stiction` where the rules do not already say so. Backlash-only valves are left out (no
+goal asks for them either way).
+"""
+
+import json
+import sys
+
+import numpy as np
+import sklearn
+from sklearn.ensemble import HistGradientBoostingClassifier
+from sklearn.model_selection import cross_val_predict
+
+TREES = 300
+LEAVES = 15
+RATE = 0.05
+MIN_LEAF = 20
+FOLDS = 5
+MOST_PROMOTED = 0.005
+THRESHOLDS = [0.5 + 0.05 * i for i in range(10)]
+CHECKS = 25
+
+
+def model():
+    return HistGradientBoostingClassifier(
+        max_iter=TREES,
+        learning_rate=RATE,
+        max_leaf_nodes=LEAVES,
+        min_samples_leaf=MIN_LEAF,
+        early_stopping=False,
+        random_state=0,
+    )
+
+
+def load(paths):
+    names, x, sticky, ruled = None, [], [], []
+    for path in paths:
+        for line in open(path):
+            r = json.loads(line)
+            d = r["diagnosis"]
+            if r["truth"] == "backlash_only" or not d.get("combined"):
+                continue
+            stats = d["combined"]["statistics"]
+            if names is None:
+                names = [s["name"] for s in stats]
+            assert [s["name"] for s in stats] == names, f"{path}: statistics differ"
+            x.append([s["value"] for s in stats])
+            sticky.append(r["truth"] == "sticky")
+            ruled.append(d["verdict"] in ("stiction", "insufficient_data"))
+    return names, np.array(x), np.array(sticky), np.array(ruled)
+
+
+def threshold(oof, sticky, ruled):
+    """The lowest threshold whose out-of-fold promotions of look-alikes stay within the limit."""
+    look = ~sticky
+    table = []
+    chosen = None
+    for t in THRESHOLDS:
+        promoted = ~ruled & (oof >= t)
+        share = promoted[look].sum() / look.sum()
+        table.append((round(t, 2), int(promoted[sticky].sum()), int(promoted[look].sum())))
+        if chosen is None and share <= MOST_PROMOTED:
+            chosen = round(t, 2)
+    return chosen, table
+
+
+def nodes(predictor):
+    """A tree's nodes as [feature, threshold, left, right, value], every node's value the
+    count-weighted mean of the leaves under it."""
+    n = predictor.nodes
+    value = [float(v) for v in n["value"]]
+
+    def fill(i):
+        if n["is_leaf"][i]:
+            return value[i], int(n["count"][i])
+        (vl, cl), (vr, cr) = fill(int(n["left"][i])), fill(int(n["right"][i]))
+        value[i] = (cl * vl + cr * vr) / (cl + cr)
+        return value[i], cl + cr
+
+    fill(0)
+    out = []
+    for i in range(len(n)):
+        if n["is_leaf"][i]:
+            out.append([0, 0.0, 0, 0, value[i]])
+        else:
+            out.append(
+                [int(n["feature_idx"][i]), float(n["num_threshold"][i]), int(n["left"][i]), int(n["right"][i]), value[i]]
+            )
+    return out
+
+
+def main():
+    out, paths = sys.argv[1], sys.argv[2:]
+    names, x, sticky, ruled = load(paths)
+    oof = cross_val_predict(model(), x, sticky, cv=FOLDS, method="predict_proba")[:, 1]
+    t, table = threshold(oof, sticky, ruled)
+    m = model().fit(x, sticky)
+    p = m.predict_proba(x)[:, 1]
+    trees = [nodes(it[0]) for it in m._predictors]
+    step = max(1, len(x) // CHECKS)
+    checks = [{"x": [float(v) for v in x[i]], "p": float(p[i])} for i in range(0, len(x), step)][:CHECKS]
+    words = ", ".join(f"{tt:.2f}: {s} sticky, {lk} look-alikes" for tt, s, lk in table)
+    calibration = (
+        f"gradient-boosted trees ({TREES} trees of up to {LEAVES} leaves, learning rate {RATE}, scikit-learn "
+        f"{sklearn.__version__}) trained on {len(x)} simulated loops ({int(sticky.sum())} sticky, {int((~sticky).sum())} "
+        f"healthy look-alikes; the catalogue's calibration sets and further draws, routine and fast, never the benchmark "
+        f"sets or the ISDB); threshold {t:.2f}: the lowest at which, out of fold, at most {100 * MOST_PROMOTED:.1f} % of the "
+        f"look-alikes would be turned to stiction (turned out of fold, at each threshold: {words})"
+    )
+    forest = {
+        "features": names,
+        "baseline": float(np.ravel(m._baseline_prediction)[0]),
+        "threshold": t,
+        "calibration": calibration,
+        "trees": trees,
+        "checks": checks,
+    }
+    with open(out, "w") as f:
+        json.dump(forest, f, separators=(",", ":"))
+        f.write("\n")
+    print(calibration)
+
+
+if __name__ == "__main__":
+    main()
