@@ -8,8 +8,10 @@ trees read, whatever trees are embedded), trains gradient-boosted trees to tell 
 from the rest, sets the threshold from which they call a valve sticky, and writes the trees.
 
 Training loops: the catalogue's calibration sets and their further draws (routine and fast),
-never the benchmark sets, draws 4-7 (the held-out draws the accuracy history judges on) or the
-ISDB:
+and the same draws' external oscillations replaced by another loop's stiction cycle (through the
+process, and through a cascade's setpoint: the propagated-oscillation example); never the
+benchmark sets, draws 4-9 (the held-out draws the accuracy history and the spread judge on) or
+the ISDB:
 
     D=/tmp/combined; mkdir -p $D
     cargo build --release -p stiction-core --example plant_benchmark
@@ -18,6 +20,8 @@ ISDB:
       $B --set $s --calibration --out $D/x.md --jsonl $D/$s-c.jsonl
       for n in 1 2 3 $(seq 10 29); do $B --set $s --extra $n --out $D/x.md --jsonl $D/$s-x$n.jsonl; done
     done
+    cargo run --release -p stiction-core --example propagated_oscillation -- --extra $(seq -s, 10 29) \
+      --out $D/x.md --jsonl $D/propagated.jsonl
     python3 -m venv $D/venv && $D/venv/bin/pip install numpy scikit-learn
     $D/venv/bin/python scripts/train_combined.py crates/stiction-core/src/diagnose/combined/forest.json $D/*.jsonl
 
@@ -56,22 +60,40 @@ def model():
     )
 
 
+def diagnoses(line):
+    """The (sticky, diagnosis) pairs of one JSON line: a plant benchmark loop (backlash-only
+    valves left out), or a propagated-oscillation line (healthy valves: the other loop's cycle,
+    and the sine moved to the setpoint; the sine through the process is the catalogue's own
+    external-oscillation loop, already read from the plant benchmark's lines)."""
+    r = json.loads(line)
+    if "diagnosis" in r:
+        if r["truth"] != "backlash_only":
+            yield r["truth"] == "sticky", r["diagnosis"]
+        return
+    yield False, r["propagated"]
+    if r["via_setpoint"]:
+        yield False, r["sine"]
+
+
 def load(paths):
     names, x, sticky, ruled = None, [], [], []
     for path in paths:
         for line in open(path):
-            r = json.loads(line)
-            d = r["diagnosis"]
-            if r["truth"] == "backlash_only" or not d.get("combined"):
-                continue
-            stats = d["combined"]["statistics"]
-            if names is None:
-                names = [s["name"] for s in stats]
-            assert [s["name"] for s in stats] == names, f"{path}: statistics differ"
-            x.append([s["value"] for s in stats])
-            sticky.append(r["truth"] == "sticky")
-            ruled.append(d["verdict"] in ("stiction", "insufficient_data"))
+            for truth, d in diagnoses(line):
+                if d.get("combined"):
+                    add(d, truth, path, names, (x, sticky, ruled))
+                    names = names or [s["name"] for s in d["combined"]["statistics"]]
     return names, np.array(x), np.array(sticky), np.array(ruled)
+
+
+def add(d, truth, path, names, out):
+    x, sticky, ruled = out
+    stats = d["combined"]["statistics"]
+    assert names is None or [s["name"] for s in stats] == names, f"{path}: statistics differ"
+    x.append([s["value"] for s in stats])
+    sticky.append(truth)
+    # the rules' own verdict: a stiction verdict the embedded trees decided was not theirs
+    ruled.append(d["verdict"] in ("stiction", "insufficient_data") and not d["combined"]["decided"])
 
 
 def threshold(oof, sticky, ruled):
@@ -127,8 +149,9 @@ def main():
     calibration = (
         f"gradient-boosted trees ({TREES} trees of up to {LEAVES} leaves, learning rate {RATE}, scikit-learn "
         f"{sklearn.__version__}) trained on {len(x)} simulated loops ({int(sticky.sum())} sticky, {int((~sticky).sum())} "
-        f"healthy look-alikes; the catalogue's calibration sets and further draws, routine and fast, never the benchmark "
-        f"sets or the ISDB); threshold {t:.2f}: the lowest at which, out of fold, at most {100 * MOST_PROMOTED:.1f} % of the "
+        f"healthy look-alikes; the catalogue's calibration set and draws 1-3 and 10-29, routine and fast, and those draws' "
+        f"external oscillations replaced by another loop's stiction cycle; never the benchmark sets, draws 4-9 or the "
+        f"ISDB); threshold {t:.2f}: the lowest at which, out of fold, at most {100 * MOST_PROMOTED:.1f} % of the "
         f"look-alikes would be turned to stiction (turned out of fold, at each threshold: {words})"
     )
     forest = {

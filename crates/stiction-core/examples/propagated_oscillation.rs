@@ -11,7 +11,10 @@
 //! Every other part of each loop is the same; each is judged as `stiction diagnose loop.csv --sp
 //! sp` judges it. Outside the benchmark's goals.
 //!
-//!     cargo run --release -p stiction-core --example propagated_oscillation -- [--out docs/propagated-oscillation.md] [--jsonl FILE]
+//!     cargo run --release -p stiction-core --example propagated_oscillation -- [--out docs/propagated-oscillation.md] [--jsonl FILE] [--extra 10,11,...]
+//!
+//! `--extra`: the catalogue's further draws instead of its calibration and benchmark sets (the
+//! loops `scripts/train_combined.py` trains on; the document's tables then name them "extra").
 //!
 //! Two sections: the cycle where the loop's own oscillation was (load or PV), judged with the setpoint,
 //! and the cycle in the setpoint of a cascade's inner loop, judged without it.
@@ -209,13 +212,13 @@ fn judge(l: &BenchmarkLoop, via_setpoint: bool) -> Diagnosis {
 /// The loops of both suites and sets, each with its own oscillation and with the upstream cycle,
 /// judged (`via_setpoint`: both moved to the setpoint and judged without it); one line each
 /// appended to `jsonl`, and the section's tables.
-fn section(via_setpoint: bool, jsonl: &mut String) -> String {
+fn section(via_setpoint: bool, sets: &[Set], jsonl: &mut String) -> String {
     let mut rows: BTreeMap<String, (Tally, Tally)> = BTreeMap::new();
     let mut skipped = 0;
     // which families voted stiction in the false alarms, each way of disturbing the loop
     let mut voters: BTreeMap<(&str, String), usize> = BTreeMap::new();
     for suite in [Suite::Routine, Suite::Fast] {
-        for set in [Set::Calibration, Set::Benchmark] {
+        for &set in sets {
             let loops: Vec<BenchmarkLoop> = catalogue(suite, set)
                 .into_iter()
                 .filter(|l| l.class == LoopClass::ExternalOscillation)
@@ -241,7 +244,8 @@ fn section(via_setpoint: bool, jsonl: &mut String) -> String {
                 },
                 match set {
                     Set::Calibration => "calibration",
-                    _ => "benchmark",
+                    Set::Benchmark => "benchmark",
+                    Set::Extra(_) => "extra",
                 }
             );
             for j in judged {
@@ -330,6 +334,19 @@ fn voters_of(d: &Diagnosis) -> String {
 
 fn main() {
     let args = StudyArgs::from_env("propagated_oscillation");
+    let sets: Vec<Set> = match args.value("--extra") {
+        None => vec![Set::Calibration, Set::Benchmark],
+        Some(list) => list
+            .split(',')
+            .map(|n| {
+                n.trim().parse().map(Set::Extra).unwrap_or_else(|_| {
+                    args.fail(&format!(
+                        "--extra {list}: draws are numbers from 1 to 255, comma-separated"
+                    ))
+                })
+            })
+            .collect(),
+    };
     let mut jsonl = String::new();
     let mut md = String::from("# A plant-wide oscillation: another loop's sticky valve\n\n");
     md.push_str(
@@ -346,7 +363,7 @@ fn main() {
          ## Through the process: on the load or on PV, where the loop's own oscillation was\n\n\
          Each loop judged as `stiction diagnose loop.csv --sp sp` judges it.\n\n",
     );
-    md.push_str(&section(false, &mut jsonl));
+    md.push_str(&section(false, &sets, &mut jsonl));
     md.push_str(
         "\n## Through the setpoint: a cascade's inner loop exported without its setpoint\n\n\
          The loop's oscillation (its own, and the upstream cycle in its place) taken off the load and PV and added to its \
@@ -354,7 +371,7 @@ fn main() {
          `stiction diagnose loop.csv` judges it, without `--sp` (the setpoint is not in the export; the error is then PV's \
          deviation from the setpoint read off the record, or from its mean).\n\n",
     );
-    md.push_str(&section(true, &mut jsonl));
+    md.push_str(&section(true, &sets, &mut jsonl));
     if let Some(path) = args.value("--jsonl") {
         std::fs::write(path, &jsonl)
             .unwrap_or_else(|e| args.fail(&format!("{path}: cannot write: {e}")));
