@@ -125,12 +125,13 @@ fn evidence(d: &Diagnosis) {
     }
     if let Some(c) = &d.combined {
         println!(
-            "    {:<24} {:<13} probability of a sticky valve {:.2} from the families' statistics read together (stiction from {:.2}; \
-             these trees only ever add a stiction verdict); towards a sticky valve most: {}",
+            "    {:<24} {:<13} probability of a sticky valve {:.2} from the families' statistics read together (trained trees; \
+             stiction from {:.2}; {}); towards a sticky valve most: {}",
             "statistics combined",
-            if c.decided { "stiction" } else { "no vote" },
+            crate::words::vote(c.vote()),
             c.probability,
             c.threshold,
+            c.role(),
             c.leading()
         );
     }

@@ -48,7 +48,9 @@ class Diagnosis(_Result):
     in % of valve span and where it comes from, for a ``stiction`` verdict), ``reach`` (the bands
     the record hides, from OP's noise: what a ``no_stiction`` verdict says little about),
     ``families`` (the
-    evidence and their votes), ``indices`` (the shape indices), ``oscillation``, ``quality``
+    evidence and their votes), ``combined`` (the families' statistics read together by trained
+    trees: ``probability`` of a sticky valve, ``decided`` when they turned the verdict to
+    ``stiction``, each statistic's ``contribution``), ``indices`` (the shape indices), ``oscillation``, ``quality``
     (the data-quality gates), ``samples``, ``ts``, ``warnings``; without a setpoint column,
     ``setpoint_read_off`` (the setpoint's steps read off OP and PV, and the levels between) when
     any were found.

@@ -48,17 +48,13 @@ pub fn evidence(d: &Diagnosis) -> Evidence {
         families.push(FamilyRow {
             family: "statistics combined",
             value: num(c.probability),
-            vote: vote_chip(if c.decided {
-                Vote::Stiction
-            } else {
-                Vote::Undetermined
-            }),
+            vote: vote_chip(c.vote()),
             statistic: "probability of a sticky valve from the families' statistics read together (trained trees)".into(),
             threshold: format!(
                 "stiction from {:.2}; never a vote against stiction (trained on simulated loops only)",
                 c.threshold
             ),
-            note: format!("towards a sticky valve most: {}", c.leading()),
+            note: format!("{}; towards a sticky valve most: {}", capital(c.role()), c.leading()),
         });
     }
     let indices = d

@@ -119,17 +119,35 @@ impl CombinedEvidence {
         }
     }
 
+    /// The trees' vote: stiction from the threshold, else none (they never vote against).
+    pub fn vote(&self) -> Vote {
+        if self.probability >= self.threshold {
+            Vote::Stiction
+        } else {
+            Vote::Undetermined
+        }
+    }
+
+    /// What the trees did to the verdict, in words.
+    pub fn role(&self) -> &'static str {
+        match (self.decided, self.vote()) {
+            (true, _) => "the trees decided the verdict",
+            (false, Vote::Stiction) => "the rules had already decided",
+            _ => "the trees only ever add a stiction verdict",
+        }
+    }
+
     /// One line for the evidence list.
     pub fn line(&self) -> String {
         format!(
-            "statistics combined: {} (probability of a sticky valve {:.2}; stiction from {:.2}; the trees only ever add a stiction verdict)",
-            if self.decided {
-                "stiction"
-            } else {
-                "no vote"
+            "statistics combined: {} (probability of a sticky valve {:.2}; stiction from {:.2}; {})",
+            match self.vote() {
+                Vote::Stiction => "stiction",
+                _ => "no vote",
             },
             self.probability,
-            self.threshold
+            self.threshold,
+            self.role()
         )
     }
 }
