@@ -387,7 +387,8 @@ const STEADY_SETPOINT: &str =
 /// One line: what to do next; on a record whose PV is mostly not recorded, a verdict other than
 /// `stiction` also says that compression hides sticks (measured by the `compressed_sticky`
 /// example: the routine benchmark's sticky loops with their PV compressed are called `stiction`
-/// in 39.6 %, 55.4 % as recorded; docs/compressed-sticky.md).
+/// in 42.1 %, 62.5 % as recorded; docs/compressed-sticky.md, 2026-11-29; 39.6 and 55.4 % before the
+/// statistics read together).
 fn next_step(
     verdict: Verdict,
     confidence: Option<f64>,
@@ -398,8 +399,8 @@ fn next_step(
     match motion.pv_not_recorded {
         Some(share) if matches!(verdict, Verdict::NoStiction | Verdict::Undetermined) => format!(
             "{step}; but PV is not recorded in {:.0} % of the samples (historian compression or a frozen transmitter), \
-             and compression hides a sticky valve's sticks (of simulated sticky valves recorded through it, 40 % were \
-             called stiction against 55 % stored whole): judge a record stored without compression before ruling the valve out",
+             and compression hides a sticky valve's sticks (of simulated sticky valves recorded through it, 42 % were \
+             called stiction against 62 % stored whole): judge a record stored without compression before ruling the valve out",
             100.0 * share
         ),
         _ => step,
