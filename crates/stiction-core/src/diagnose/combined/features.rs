@@ -20,74 +20,175 @@ pub struct Stretch<'a> {
     pub samples: usize,
 }
 
-/// The statistics' names (the trees' inputs, in order) and each in words.
-pub const NAMES: [(&str, &str); COUNT] = [
-    ("model_test_ratio", "the closed-loop fit's test ratio"),
-    ("model_improvement", "the fit's improvement with stiction"),
+/// How a statistic is read: as it is, on a signed log scale, as a natural log, or a vote.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scale {
+    /// As it is.
+    Plain,
+    /// `sign(x) ln(1 + |x|)`: counts, ratios and spans over decades.
+    SignedLog,
+    /// `ln(x)`: the sampling time and the samples.
+    Ln,
+    /// A family's vote: +1 stiction, -1 none, 0 undetermined.
+    Vote,
+}
+
+impl Scale {
+    /// A value read on this scale, back on its own.
+    pub fn undo(self, v: f64) -> f64 {
+        match self {
+            Scale::SignedLog => v.signum() * v.abs().exp_m1(),
+            Scale::Ln => v.exp(),
+            Scale::Plain | Scale::Vote => v,
+        }
+    }
+}
+
+/// The statistics' names (the trees' inputs, in order), each in words, and how it is read.
+pub const NAMES: [(&str, &str, Scale); COUNT] = [
+    (
+        "model_test_ratio",
+        "the closed-loop fit's test ratio",
+        Scale::SignedLog,
+    ),
+    (
+        "model_improvement",
+        "the fit's improvement with stiction",
+        Scale::Plain,
+    ),
     (
         "model_explained",
         "the share of PV the stiction fit explains",
+        Scale::Plain,
     ),
-    ("model_r2_linear", "the linear loop's R²"),
-    ("model_r2_stenman", "Stenman's fit's R²"),
-    ("model_r2_slip_jump", "the slip-jump fit's R²"),
-    ("model_loop_gain", "the fitted loop gain"),
-    ("model_noise_share", "the noise's share of PV's changes"),
-    ("model_correlation_span", "the fits' correlation span"),
+    ("model_r2_linear", "the linear loop's R²", Scale::Plain),
+    ("model_r2_stenman", "Stenman's fit's R²", Scale::Plain),
+    ("model_r2_slip_jump", "the slip-jump fit's R²", Scale::Plain),
+    ("model_loop_gain", "the fitted loop gain", Scale::Plain),
+    (
+        "model_noise_share",
+        "the noise's share of PV's changes",
+        Scale::Plain,
+    ),
+    (
+        "model_correlation_span",
+        "the fits' correlation span",
+        Scale::SignedLog,
+    ),
     (
         "model_band_over_op_noise",
         "the fitted band over OP's noise",
+        Scale::SignedLog,
     ),
     (
         "model_slip_band_over_op_noise",
         "the slip-jump band over OP's noise",
+        Scale::SignedLog,
     ),
-    ("model_slip_over_band", "the fitted slip jump over its band"),
-    ("stick_slip_episodes", "the stick-slip episodes"),
+    (
+        "model_slip_over_band",
+        "the fitted slip jump over its band",
+        Scale::Plain,
+    ),
+    (
+        "stick_slip_episodes",
+        "the stick-slip episodes",
+        Scale::SignedLog,
+    ),
     (
         "stick_slip_stuck_share",
         "the share of OP's travel spent stuck",
+        Scale::Plain,
     ),
     (
         "stick_slip_travel_over_op_noise",
         "OP's travel per stick over its noise",
+        Scale::SignedLog,
     ),
-    ("stick_slip_quiet_stretches", "the stretches of quiet PV"),
-    ("shape_score", "the shape indices' score"),
-    ("shape_vote", "the shape family's vote"),
-    ("loop_needed_lag", "the valve lag the loop needs"),
-    ("loop_vote", "the loop family's vote"),
-    ("model_vote", "the closed-loop fit's vote"),
-    ("stick_slip_vote", "the stick-slip vote"),
-    ("oscillating", "an oscillation"),
-    ("regularity", "the oscillation's regularity"),
-    ("periods_in_record", "the periods in the record"),
+    (
+        "stick_slip_quiet_stretches",
+        "the stretches of quiet PV",
+        Scale::SignedLog,
+    ),
+    ("shape_score", "the shape indices' score", Scale::Plain),
+    ("shape_vote", "the shape family's vote", Scale::Vote),
+    (
+        "loop_needed_lag",
+        "the valve lag the loop needs",
+        Scale::Plain,
+    ),
+    ("loop_vote", "the loop family's vote", Scale::Vote),
+    ("model_vote", "the closed-loop fit's vote", Scale::Vote),
+    ("stick_slip_vote", "the stick-slip vote", Scale::Vote),
+    ("oscillating", "an oscillation", Scale::Plain),
+    (
+        "regularity",
+        "the oscillation's regularity",
+        Scale::SignedLog,
+    ),
+    (
+        "periods_in_record",
+        "the periods in the record",
+        Scale::SignedLog,
+    ),
     (
         "amplitude_over_noise",
         "the oscillation's amplitude over the noise",
+        Scale::SignedLog,
     ),
-    ("log_ts", "the sampling time"),
-    ("log_samples", "the samples judged"),
-    ("loop_gain_margin", "the linear loop's gain margin"),
-    ("loop_residual_share", "PV's cycle OP does not explain"),
-    ("loop_harmonics", "the cycle's harmonics"),
-    ("loop_amplitude_scatter", "the cycle's amplitude scatter"),
-    ("loop_amplitude_change", "the cycle's amplitude change"),
-    ("loop_phase_wander", "the cycle's phase wander"),
-    ("loop_needed_gain", "the valve gain the loop needs"),
+    ("log_ts", "the sampling time", Scale::Ln),
+    ("log_samples", "the samples judged", Scale::Ln),
+    (
+        "loop_gain_margin",
+        "the linear loop's gain margin",
+        Scale::Plain,
+    ),
+    (
+        "loop_residual_share",
+        "PV's cycle OP does not explain",
+        Scale::Plain,
+    ),
+    ("loop_harmonics", "the cycle's harmonics", Scale::SignedLog),
+    (
+        "loop_amplitude_scatter",
+        "the cycle's amplitude scatter",
+        Scale::Plain,
+    ),
+    (
+        "loop_amplitude_change",
+        "the cycle's amplitude change",
+        Scale::SignedLog,
+    ),
+    (
+        "loop_phase_wander",
+        "the cycle's phase wander",
+        Scale::SignedLog,
+    ),
+    (
+        "loop_needed_gain",
+        "the valve gain the loop needs",
+        Scale::Plain,
+    ),
     (
         "loop_describing_distance",
         "the describing function's distance",
+        Scale::SignedLog,
     ),
     (
         "model_cycle_cancelled_ratio",
         "the fits' test ratio over whole periods",
+        Scale::SignedLog,
     ),
     (
         "loop_controller_residual",
         "OP the identified PI does not explain",
+        Scale::Plain,
     ),
-    ("loop_op_at_limit", "OP at a limit in the cycle"),
+    (
+        "loop_op_at_limit",
+        "OP at a limit in the cycle",
+        Scale::Plain,
+    ),
 ];
 
 /// How many statistics the combination reads.

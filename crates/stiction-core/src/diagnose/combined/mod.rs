@@ -68,7 +68,7 @@ impl CombinedEvidence {
                 .iter()
                 .zip(x)
                 .zip(reading.contributions)
-                .map(|((&(name, _), value), contribution)| Statistic {
+                .map(|((&(name, ..), value), contribution)| Statistic {
                     name: name.into(),
                     value,
                     contribution,
@@ -110,7 +110,13 @@ impl CombinedEvidence {
             .iter()
             .take(NAMED)
             .filter(|(_, s)| s.contribution > 0.0)
-            .map(|&(i, s)| format!("{} ({})", features::NAMES[i].1, shown(s)))
+            .map(|&(i, s)| {
+                format!(
+                    "{} ({})",
+                    features::NAMES[i].1,
+                    shown(s, features::NAMES[i].2)
+                )
+            })
             .collect();
         match words.as_slice() {
             [] => "no single statistic".into(),
@@ -152,42 +158,16 @@ impl CombinedEvidence {
     }
 }
 
-/// A statistic's value as a person reads it: votes as words, log-scaled ones back on their own
-/// scale.
-fn shown(s: &Statistic) -> String {
-    if s.name.ends_with("_vote") {
+/// A statistic's value as a person reads it: votes as words, the others on their own scale.
+fn shown(s: &Statistic, scale: features::Scale) -> String {
+    if scale == features::Scale::Vote {
         return match s.value {
             v if v > 0.5 => "stiction".into(),
             v if v < -0.5 => "none".into(),
             _ => "undetermined".into(),
         };
     }
-    let logged = matches!(
-        s.name.as_str(),
-        "model_test_ratio"
-            | "model_correlation_span"
-            | "model_band_over_op_noise"
-            | "model_slip_band_over_op_noise"
-            | "stick_slip_episodes"
-            | "stick_slip_travel_over_op_noise"
-            | "stick_slip_quiet_stretches"
-            | "regularity"
-            | "periods_in_record"
-            | "amplitude_over_noise"
-            | "loop_harmonics"
-            | "loop_amplitude_change"
-            | "loop_phase_wander"
-            | "loop_describing_distance"
-            | "model_cycle_cancelled_ratio"
-    );
-    let v = if logged {
-        s.value.signum() * s.value.abs().exp_m1()
-    } else if matches!(s.name.as_str(), "log_ts" | "log_samples") {
-        s.value.exp()
-    } else {
-        s.value
-    };
-    format!("{}", Sig3(v))
+    format!("{}", Sig3(scale.undo(s.value)))
 }
 
 /// Three significant figures.

@@ -5,7 +5,7 @@ use super::forest;
 fn the_trees_read_the_statistics_the_families_report_in_order() {
     let f = forest().expect("trained trees are embedded");
     assert_eq!(f.features.len(), COUNT);
-    for (name, (expected, _)) in f.features.iter().zip(NAMES) {
+    for (name, (expected, ..)) in f.features.iter().zip(NAMES) {
         assert_eq!(name, expected);
     }
     assert!(
@@ -90,7 +90,7 @@ fn the_reason_names_the_statistics_that_weighed_most() {
     e.statistics = NAMES
         .iter()
         .enumerate()
-        .map(|(i, &(name, _))| super::Statistic {
+        .map(|(i, &(name, ..))| super::Statistic {
             name: name.into(),
             value: if name == "model_test_ratio" {
                 12.0_f64.ln_1p()
