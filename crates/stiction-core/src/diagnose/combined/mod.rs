@@ -7,7 +7,7 @@
 //! finds sticky valves the rules leave `no_stiction` or `undetermined`.
 //!
 //! The trees only ever add a `stiction` verdict, and only from a probability calibrated to add
-//! few look-alikes: out of fold on their training loops, about one healthy loop in a hundred.
+//! few look-alikes: out of fold on their training loops, under one healthy loop in 200.
 //! They never take one away, never decide where the valve position is recorded, and never
 //! decide against stiction: a learned combination does not hold where the catalogue does not
 //! teach it (docs/accuracy-history.md, "A learned combination of the families' statistics": as
@@ -104,18 +104,15 @@ impl CombinedEvidence {
 
     /// The statistics that weighed most towards a sticky valve, in words with their values.
     pub fn leading(&self) -> String {
-        let mut order: Vec<(usize, &Statistic)> = self.statistics.iter().enumerate().collect();
-        order.sort_by(|a, b| b.1.contribution.total_cmp(&a.1.contribution));
+        let mut order: Vec<&Statistic> = self.statistics.iter().collect();
+        order.sort_by(|a, b| b.contribution.total_cmp(&a.contribution));
         let words: Vec<String> = order
             .iter()
             .take(NAMED)
-            .filter(|(_, s)| s.contribution > 0.0)
-            .map(|&(i, s)| {
-                format!(
-                    "{} ({})",
-                    features::NAMES[i].1,
-                    shown(s, features::NAMES[i].2)
-                )
+            .filter(|s| s.contribution > 0.0)
+            .map(|s| match features::NAMES.iter().find(|n| n.0 == s.name) {
+                Some(&(_, words, scale)) => format!("{words} ({})", shown(s, scale)),
+                None => format!("{} ({})", s.name, Sig3(s.value)),
             })
             .collect();
         match words.as_slice() {
