@@ -72,6 +72,14 @@ fn a_sticky_loop_is_stiction_with_the_band_sized() {
     assert!(text.contains("closed-loop fit: R²"), "{text}");
     assert!(text.contains("% of valve span"), "{text}");
     assert!(text.contains("next step:"), "{text}");
+    // the statistics read together agree with the rules, which decided
+    assert!(
+        text.lines()
+            .any(|l| l.trim_start().starts_with("statistics combined")
+                && l.contains("the rules had already decided")),
+        "{text}"
+    );
+    assert_eq!(v["combined"]["decided"], false, "{v:#}");
     assert_eq!(v["quantification"]["valve_start_kind"], "first_op");
     let v = json(&ok(&[
         "diagnose",
@@ -101,7 +109,23 @@ fn a_healthy_loop_with_noise_only_is_no_stiction() {
     let small = reach["small_band_percent_of_span"].as_f64().unwrap();
     let large = reach["large_band_percent_of_span"].as_f64().unwrap();
     assert!((small - 4.0 * sd).abs() < 1e-9 && (large - 12.0 * sd).abs() < 1e-9);
+    // the statistics read together cast no vote on a healthy valve, and say so
+    let combined = &v["combined"];
+    assert!(
+        combined["probability"].as_f64().unwrap() < combined["threshold"].as_f64().unwrap(),
+        "{combined:#}"
+    );
+    assert_eq!(combined["decided"], false);
+    assert_eq!(combined["statistics"].as_array().unwrap().len(), 39);
     let human = ok(&["diagnose", &f, "--sp", "sp"]);
+    assert!(
+        human
+            .lines()
+            .any(|l| l.trim_start().starts_with("statistics combined")
+                && l.contains("undetermined")
+                && l.contains("only ever add a stiction verdict")),
+        "{human}"
+    );
     let line = human
         .lines()
         .find(|l| l.trim_start().starts_with("what this record can show:"))
