@@ -6,7 +6,7 @@
 //! table by band over the OP's noise), so a `no_stiction` verdict speaks for large bands and is
 //! nearly silent on small ones.
 
-use super::{DiagnoseRequest, Diagnosis, Family};
+use super::{DiagnoseRequest, Diagnosis, Family, FamilyEvidence};
 use serde::{Deserialize, Serialize};
 
 /// A small band: under this many OP noise standard deviations.
@@ -80,13 +80,17 @@ pub fn found_words(found: [f64; 2]) -> String {
 /// The reach of the stretch judged in `d` (OP `op`): OP's noise as the stick-slip family measured
 /// it, or measured here when that family did not judge.
 pub(super) fn of(d: &Diagnosis, op: &[f64], req: &DiagnoseRequest) -> Option<Reach> {
-    let op_noise = d
-        .families
+    Reach::new(op_noise(&d.families, || crate::detect::held_noise(op)), req)
+}
+
+/// OP's noise standard deviation as the reach reads it: the stick-slip family's, or `measured`
+/// when that family did not judge.
+pub(super) fn op_noise(families: &[FamilyEvidence], measured: impl FnOnce() -> f64) -> f64 {
+    families
         .iter()
         .find(|f| f.family == Family::StickSlip)
         .and_then(|f| f.stick_slip.as_ref())
-        .map_or_else(|| crate::detect::held_noise(op), |s| s.op_noise);
-    Reach::new(op_noise, req)
+        .map_or_else(measured, |s| s.op_noise)
 }
 
 #[cfg(test)]

@@ -11,8 +11,8 @@ pub struct Stretch<'a> {
     pub families: &'a [FamilyEvidence],
     /// The oscillation found.
     pub oscillation: &'a Oscillation,
-    /// OP's noise standard deviation (OP units), as the reach reads it when the stick-slip
-    /// family did not.
+    /// OP's noise standard deviation (OP units), as the reach reads it
+    /// (`diagnose::reach::op_noise`).
     pub op_noise: f64,
     /// Sampling time, seconds.
     pub ts: f64,
@@ -214,7 +214,7 @@ pub fn of(s: &Stretch) -> [f64; COUNT] {
     let stick = family(fams, Family::StickSlip).and_then(|f| f.stick_slip.as_ref());
     let cycle = family(fams, Family::Loop).and_then(|f| f.limit_cycle.as_ref());
     let value = |f: Family| family(fams, f).and_then(|e| e.value).unwrap_or(0.0);
-    let op_noise = stick.map_or(s.op_noise, |e| e.op_noise).max(1e-6);
+    let op_noise = s.op_noise.max(1e-6);
     let m = |g: &dyn Fn(&crate::diagnose::evidence::ModelEvidence) -> f64| model.map_or(0.0, g);
     let st =
         |g: &dyn Fn(&crate::diagnose::evidence::StickSlipEvidence) -> f64| stick.map_or(0.0, g);
