@@ -3,7 +3,7 @@
 
 Not part of the tests (needs numpy and scikit-learn); the trees it writes are committed in
 crates/stiction-core/src/diagnose/combined/forest.json. It reads the JSON lines the plant
-benchmark writes (each loop's diagnosis carries `combined.statistics`, the 39 statistics the
+benchmark writes (each loop's diagnosis carries `combined.statistics`, the 45 statistics the
 trees read, whatever trees are embedded), trains gradient-boosted trees to tell the sticky valves
 from the rest, sets the threshold from which they call a valve sticky, and writes the trees.
 
@@ -14,6 +14,10 @@ benchmark sets, draws 4-9 (the held-out draws the accuracy history and the sprea
 the ISDB:
 
     D=/tmp/combined; mkdir -p $D
+    python3 -m venv $D/venv && $D/venv/bin/pip install numpy scikit-learn
+    # only when the statistics changed (the embedded trees read another list, so the diagnoses
+    # carry none): embed trees that read the new list and never decide, then build
+    $D/venv/bin/python scripts/train_combined.py --placeholder crates/stiction-core/src/diagnose/combined/forest.json
     cargo build --release -p stiction-core --example plant_benchmark
     B=target/release/examples/plant_benchmark
     for s in routine fast; do
@@ -22,22 +26,23 @@ the ISDB:
     done
     cargo run --release -p stiction-core --example propagated_oscillation -- --extra $(seq -s, 10 29) \
       --out $D/x.md --jsonl $D/propagated.jsonl
-    python3 -m venv $D/venv && $D/venv/bin/pip install numpy scikit-learn
     $D/venv/bin/python scripts/train_combined.py crates/stiction-core/src/diagnose/combined/forest.json $D/*.jsonl
 
 The threshold: the lowest of 0.50, 0.55, ..., 0.95 at which, out of fold (five folds of the
-training loops), the trees would turn at most 0.5 % of the look-alikes (healthy valves of every
+training loops, drawn at random with seed 0), the trees would turn at most 0.5 % of the look-alikes (healthy valves of every
 kind) to `stiction` where the rules do not already say so. Backlash-only valves are left out (no
 goal asks for them either way).
 """
 
 import json
+import pathlib
+import re
 import sys
 
 import numpy as np
 import sklearn
 from sklearn.ensemble import HistGradientBoostingClassifier
-from sklearn.model_selection import cross_val_predict
+from sklearn.model_selection import StratifiedKFold, cross_val_predict
 
 TREES = 300
 LEAVES = 15
@@ -135,10 +140,38 @@ def nodes(predictor):
     return out
 
 
+FEATURES = pathlib.Path(__file__).parent.parent / "crates/stiction-core/src/diagnose/combined/features.rs"
+
+
+def placeholder(out):
+    """Trees that read the statistics `features.rs` names and never decide (one leaf, a
+    probability of about 2e-9): the build then reports the new statistics to train on."""
+    table = FEATURES.read_text().split("pub const NAMES")[1].split("];")[0]
+    names = re.findall(r'\(\s*"([a-z0-9_]+)",', table)
+    forest = {
+        "features": names,
+        "baseline": -20.0,
+        "threshold": 0.99,
+        "calibration": "placeholder: untrained, never decides",
+        "trees": [[[0, 0.0, 0, 0, 0.0]]],
+        "checks": [],
+    }
+    with open(out, "w") as f:
+        json.dump(forest, f)
+        f.write("\n")
+    print(f"{out}: placeholder trees reading {len(names)} statistics")
+
+
 def main():
+    if sys.argv[1] == "--placeholder":
+        placeholder(sys.argv[2])
+        return
     out, paths = sys.argv[1], sys.argv[2:]
     names, x, sticky, ruled = load(paths)
-    oof = cross_val_predict(model(), x, sticky, cv=FOLDS, method="predict_proba")[:, 1]
+    # folds drawn at random (seeded): without shuffling they would follow the files' order and
+    # hold whole draws or kinds of loops out of some folds, and the threshold would hang on it
+    folds = StratifiedKFold(FOLDS, shuffle=True, random_state=0)
+    oof = cross_val_predict(model(), x, sticky, cv=folds, method="predict_proba")[:, 1]
     t, table = threshold(oof, sticky, ruled)
     m = model().fit(x, sticky)
     p = m.predict_proba(x)[:, 1]
@@ -151,7 +184,7 @@ def main():
         f"{sklearn.__version__}) trained on {len(x)} simulated loops ({int(sticky.sum())} sticky, {int((~sticky).sum())} "
         f"healthy look-alikes; the catalogue's calibration set and draws 1-3 and 10-29, routine and fast, and those draws' "
         f"external oscillations replaced by another loop's stiction cycle; never the benchmark sets, draws 4-9 or the "
-        f"ISDB); threshold {t:.2f}: the lowest at which, out of fold, at most {100 * MOST_PROMOTED:.1f} % of the "
+        f"ISDB); threshold {t:.2f}: the lowest at which, out of fold (five seeded random folds), at most {100 * MOST_PROMOTED:.1f} % of the "
         f"look-alikes would be turned to stiction (turned out of fold, at each threshold: {words})"
     )
     forest = {

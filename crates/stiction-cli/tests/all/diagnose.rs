@@ -116,7 +116,7 @@ fn a_healthy_loop_with_noise_only_is_no_stiction() {
         "{combined:#}"
     );
     assert_eq!(combined["decided"], false);
-    assert_eq!(combined["statistics"].as_array().unwrap().len(), 39);
+    assert_eq!(combined["statistics"].as_array().unwrap().len(), 45);
     let human = ok(&["diagnose", &f, "--sp", "sp"]);
     assert!(
         human

@@ -128,6 +128,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
     let mut combined = combined::CombinedEvidence::of(&combined::features::Stretch {
         families: &families,
         oscillation: &ctx.oscillation,
+        indices: ctx.indices.get().map_or(&[], Vec::as_slice),
         op_noise: reach::op_noise(&families, || ctx.op_noise),
         ts: req.ts,
         samples: r.op.len(),

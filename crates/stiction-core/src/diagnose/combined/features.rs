@@ -3,7 +3,7 @@
 //! that run over decades are read on a signed log scale.
 
 use crate::diagnose::evidence::{Family, FamilyEvidence};
-use crate::diagnose::result::Oscillation;
+use crate::diagnose::result::{Index, Oscillation};
 
 /// What the combination reads of one judged stretch besides the families.
 pub struct Stretch<'a> {
@@ -11,6 +11,8 @@ pub struct Stretch<'a> {
     pub families: &'a [FamilyEvidence],
     /// The oscillation found.
     pub oscillation: &'a Oscillation,
+    /// The shape family's indices (none where the stretch does not oscillate).
+    pub indices: &'a [Index],
     /// OP's noise standard deviation (OP units), as the reach reads it
     /// (`diagnose::reach::op_noise`).
     pub op_noise: f64,
@@ -31,7 +33,12 @@ pub enum Scale {
     Ln,
     /// A family's vote: +1 stiction, -1 none, 0 undetermined.
     Vote,
+    /// A shape index's value as it is, [`NOT_COMPUTED`] where it could not be computed.
+    Index,
 }
+
+/// What a shape index reads where it was not computed (below every index's range).
+pub const NOT_COMPUTED: f64 = -9.0;
 
 impl Scale {
     /// A value read on this scale, back on its own.
@@ -39,7 +46,7 @@ impl Scale {
         match self {
             Scale::SignedLog => v.signum() * v.abs().exp_m1(),
             Scale::Ln => v.exp(),
-            Scale::Plain | Scale::Vote => v,
+            Scale::Plain | Scale::Vote | Scale::Index => v,
         }
     }
 }
@@ -189,10 +196,37 @@ pub const NAMES: [(&str, &str, Scale); COUNT] = [
         "OP at a limit in the cycle",
         Scale::Plain,
     ),
+    (
+        "cross_correlation",
+        "the cross-correlation index",
+        Scale::Index,
+    ),
+    ("curve_fitting", "the curve-fitting index", Scale::Index),
+    ("harmonics", "the harmonics index", Scale::Index),
+    ("shape", "Hägglund's shape index", Scale::Index),
+    ("bicoherence", "the bicoherence index", Scale::Index),
+    (
+        "ddpv_histogram",
+        "the histogram index of PV's second difference",
+        Scale::Index,
+    ),
 ];
 
 /// How many statistics the combination reads.
-pub const COUNT: usize = 39;
+pub const COUNT: usize = 45;
+
+/// The shape indices the combination reads, by their names in [`NAMES`] (the last six).
+const INDICES: usize = 6;
+
+/// A shape index's value by name, [`NOT_COMPUTED`] where missing.
+fn index(indices: &[Index], name: &str) -> f64 {
+    indices
+        .iter()
+        .find(|i| i.name == name)
+        .and_then(|i| i.value)
+        .filter(|v| v.is_finite())
+        .unwrap_or(NOT_COMPUTED)
+}
 
 /// A count or ratio over decades, on a signed log scale.
 fn slog(x: f64) -> f64 {
@@ -223,7 +257,7 @@ pub fn of(s: &Stretch) -> [f64; COUNT] {
         cycle.and_then(|c| c.amplitude.as_ref()).map_or(0.0, g)
     };
     let o = s.oscillation;
-    let x = [
+    let x: [f64; COUNT - INDICES] = [
         m(&|e| slog(e.significance)),
         m(&|e| e.improvement),
         m(&|e| e.explained),
@@ -272,5 +306,13 @@ pub fn of(s: &Stretch) -> [f64; COUNT] {
         lc(&|e| e.controller_residual_share),
         lc(&|e| e.op_at_limit),
     ];
-    x.map(|v| if v.is_finite() { v } else { 0.0 })
+    let mut all = [0.0; COUNT];
+    all[..COUNT - INDICES].copy_from_slice(&x);
+    for (v, (name, ..)) in all[COUNT - INDICES..]
+        .iter_mut()
+        .zip(&NAMES[COUNT - INDICES..])
+    {
+        *v = index(s.indices, name);
+    }
+    all.map(|v| if v.is_finite() { v } else { 0.0 })
 }

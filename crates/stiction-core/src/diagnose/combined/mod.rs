@@ -1,6 +1,6 @@
 //! The families' statistics read together: gradient-boosted trees, trained on simulated loops
 //! of many kinds (the catalogue's calibration draws, routine and fast; never the ISDB), give the
-//! probability of a sticky valve from the 39 statistics the families report
+//! probability of a sticky valve from the 45 statistics the families report
 //! ([`features::NAMES`]). The verdict's rules read each family's vote and a few of its figures;
 //! the trees also read how the figures go together (a closed-loop fit's test ratio between its
 //! thresholds while the stick-slip episodes and the oscillation's amplitude say more), which
@@ -79,8 +79,9 @@ impl CombinedEvidence {
     }
 
     /// Whether the trees turn `verdict` to `stiction`: their probability reaches the threshold,
-    /// the rules did not already say `stiction` or find nothing to judge, and no recorded valve
-    /// position decided.
+    /// the rules did not already say `stiction` or find nothing to judge, no recorded valve
+    /// position decided, and OP drives PV (where no valve, sticky or not, lets OP explain PV's
+    /// variation, it enters the loop elsewhere: the trees never saw such a loop called sticky).
     pub fn decides(&self, verdict: Verdict, families: &[FamilyEvidence]) -> bool {
         let valve_voted = families
             .iter()
@@ -88,6 +89,7 @@ impl CombinedEvidence {
         self.probability >= self.threshold
             && matches!(verdict, Verdict::NoStiction | Verdict::Undetermined)
             && !valve_voted
+            && !super::verdict::op_does_not_drive(families)
     }
 
     /// The verdict's reason when the trees decide.
@@ -163,6 +165,9 @@ fn shown(s: &Statistic, scale: features::Scale) -> String {
             v if v < -0.5 => "none".into(),
             _ => "undetermined".into(),
         };
+    }
+    if scale == features::Scale::Index && s.value <= features::NOT_COMPUTED {
+        return "not computed".into();
     }
     format!("{}", Sig3(scale.undo(s.value)))
 }

@@ -109,3 +109,58 @@ fn the_reason_names_the_statistics_that_weighed_most() {
     );
     assert!(why.ends_with("the rules alone said no_stiction"), "{why}");
 }
+
+#[test]
+fn the_shape_indices_are_read_by_name_and_missing_ones_say_so() {
+    use super::features::{Scale, Stretch, NOT_COMPUTED};
+    use crate::diagnose::result::{Index, Vote};
+    let index = |name: &str, value: Option<f64>| Index {
+        name: name.into(),
+        reference: String::new(),
+        value,
+        threshold: String::new(),
+        vote: Vote::Undetermined,
+        weight: 1.0,
+        only_votes: None,
+        note: String::new(),
+    };
+    // out of order, one not computed, one unknown to the trees
+    let indices = [
+        index("harmonics", Some(0.4)),
+        index("cross_correlation", Some(0.9)),
+        index("curve_fitting", None),
+        index("a_new_index", Some(5.0)),
+    ];
+    let error: Vec<f64> = (0..200).map(|i| (i as f64 * 0.7).sin() * 1e-3).collect();
+    let oscillation = crate::diagnose::oscillation::of_record(&error, None, 1.0);
+    let x = super::features::of(&Stretch {
+        families: &[],
+        oscillation: &oscillation,
+        indices: &indices,
+        op_noise: 0.1,
+        ts: 1.0,
+        samples: 100,
+    });
+    let at = |name: &str| x[NAMES.iter().position(|n| n.0 == name).expect(name)];
+    assert_eq!(at("cross_correlation"), 0.9);
+    assert_eq!(at("harmonics"), 0.4);
+    assert_eq!(at("curve_fitting"), NOT_COMPUTED);
+    assert_eq!(at("bicoherence"), NOT_COMPUTED);
+    // a missing index reads "not computed" in the reason, a computed one its value
+    let mut e = evidence(0.9);
+    e.statistics = ["curve_fitting", "cross_correlation"]
+        .iter()
+        .map(|&name| super::Statistic {
+            name: name.into(),
+            value: at(name),
+            contribution: 1.0,
+        })
+        .collect();
+    let words = e.leading();
+    assert!(
+        words.contains("the curve-fitting index (not computed)")
+            && words.contains("the cross-correlation index (0.900)"),
+        "{words}"
+    );
+    assert!(NAMES.iter().filter(|n| n.2 == Scale::Index).count() == 6);
+}

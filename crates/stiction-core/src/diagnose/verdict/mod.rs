@@ -439,6 +439,17 @@ fn cycle_alone(families: &[FamilyEvidence]) -> bool {
     voters.peek().is_some() && voters.all(|f| matches!(f.family, Family::Shape | Family::Loop))
 }
 
+/// Whether the closed-loop fit found that OP does not drive PV through any valve.
+pub(super) fn op_does_not_drive(families: &[FamilyEvidence]) -> bool {
+    families.iter().any(|f| {
+        f.family == Family::Model
+            && f.vote == Vote::NoStiction
+            && f.model
+                .as_ref()
+                .is_some_and(|m| m.explained < super::evidence::model::MIN_EXPLAINED)
+    })
+}
+
 fn next_step_of(
     verdict: Verdict,
     confidence: Option<f64>,
@@ -446,13 +457,7 @@ fn next_step_of(
     motion: &Motion,
 ) -> String {
     let voted = |fam: Family, v: Vote| families.iter().any(|f| f.family == fam && f.vote == v);
-    let op_does_not_drive = families.iter().any(|f| {
-        f.family == Family::Model
-            && f.vote == Vote::NoStiction
-            && f.model
-                .as_ref()
-                .is_some_and(|m| m.explained < super::evidence::model::MIN_EXPLAINED)
-    });
+    let op_does_not_drive = op_does_not_drive(families);
     // the closed-loop fit's stiction vote withdrawn: its gain lay in a cycle that keeps time
     let clock_cycle = families.iter().any(|f| {
         f.family == Family::Model

@@ -36,6 +36,9 @@ fn a_healthy_valve_keeps_the_rules_verdict() {
     assert_eq!(d.verdict, Verdict::NoStiction, "{:?}", d.evidence);
     let c = d.combined.as_ref().unwrap();
     assert!(!c.decided && c.probability < 0.2, "{c:?}");
-    assert_eq!(c.statistics.len(), 39);
+    assert_eq!(
+        c.statistics.len(),
+        stiction_core::diagnose::combined::features::COUNT
+    );
     assert!(c.statistics.iter().all(|s| s.value.is_finite()));
 }
