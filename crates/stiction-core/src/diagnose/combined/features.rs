@@ -1,6 +1,7 @@
 //! The statistics the combination reads: what the families measured, as numbers, in one order.
-//! Each is taken as the families report it (a missing one reads 0); counts, ratios and spans
-//! that run over decades are read on a signed log scale.
+//! Each is taken as the families report it (a missing one reads 0, a shape index not computed
+//! [`NOT_COMPUTED`]); counts, ratios and spans that run over decades are read on a signed log
+//! scale.
 
 use crate::diagnose::evidence::{Family, FamilyEvidence};
 use crate::diagnose::result::{Index, Oscillation};
