@@ -39,10 +39,7 @@ import pathlib
 import re
 import sys
 
-import numpy as np
-import sklearn
-from sklearn.ensemble import HistGradientBoostingClassifier
-from sklearn.model_selection import StratifiedKFold, cross_val_predict
+# numpy and scikit-learn are imported where they are needed: `--placeholder` needs neither
 
 TREES = 300
 LEAVES = 15
@@ -55,6 +52,8 @@ CHECKS = 25
 
 
 def model():
+    from sklearn.ensemble import HistGradientBoostingClassifier
+
     return HistGradientBoostingClassifier(
         max_iter=TREES,
         learning_rate=RATE,
@@ -81,6 +80,8 @@ def diagnoses(line):
 
 
 def load(paths):
+    import numpy as np
+
     names, x, sticky, ruled = None, [], [], []
     for path in paths:
         for line in open(path):
@@ -166,6 +167,10 @@ def main():
     if sys.argv[1] == "--placeholder":
         placeholder(sys.argv[2])
         return
+    import numpy as np
+    import sklearn
+    from sklearn.model_selection import StratifiedKFold, cross_val_predict
+
     out, paths = sys.argv[1], sys.argv[2:]
     names, x, sticky, ruled = load(paths)
     # folds drawn at random (seeded): without shuffling they would follow the files' order and
