@@ -30,8 +30,11 @@ the ISDB:
 
 The threshold: the lowest of 0.50, 0.55, ..., 0.95 at which, out of fold (five folds of the
 training loops, drawn at random with seed 0), the trees would turn at most 0.5 % of the look-alikes (healthy valves of every
-kind) to `stiction` where the rules do not already say so. Backlash-only valves are left out (no
-goal asks for them either way).
+kind) to `stiction` where the rules do not already say so. Where the rules are `undetermined` (they
+give the engineer no answer, and the trees tell the sticky valves there from the rest far better)
+the threshold is lower: the lowest of 0.50, 0.55, ... at which the look-alikes turned, the
+`no_stiction` ones from the first threshold and the `undetermined` ones from this one, still stay
+within 0.5 %. Backlash-only valves are left out (no goal asks for them either way).
 """
 
 import json
@@ -82,24 +85,25 @@ def diagnoses(line):
 def load(paths):
     import numpy as np
 
-    names, x, sticky, ruled = None, [], [], []
+    names, x, sticky, ruled, undetermined = None, [], [], [], []
     for path in paths:
         for line in open(path):
             for truth, d in diagnoses(line):
                 if d.get("combined"):
-                    add(d, truth, path, names, (x, sticky, ruled))
+                    add(d, truth, path, names, (x, sticky, ruled, undetermined))
                     names = names or [s["name"] for s in d["combined"]["statistics"]]
-    return names, np.array(x), np.array(sticky), np.array(ruled)
+    return names, np.array(x), np.array(sticky), np.array(ruled), np.array(undetermined)
 
 
 def add(d, truth, path, names, out):
-    x, sticky, ruled = out
+    x, sticky, ruled, undetermined = out
     stats = d["combined"]["statistics"]
     assert names is None or [s["name"] for s in stats] == names, f"{path}: statistics differ"
     x.append([s["value"] for s in stats])
     sticky.append(truth)
     # the rules' own verdict: a stiction verdict the embedded trees decided was not theirs
     ruled.append(d["verdict"] in ("stiction", "insufficient_data") and not d["combined"]["decided"])
+    undetermined.append(d["combined"].get("before", d["verdict"]) == "undetermined")
 
 
 def threshold(oof, sticky, ruled):
@@ -114,6 +118,22 @@ def threshold(oof, sticky, ruled):
         if chosen is None and share <= MOST_PROMOTED:
             chosen = round(t, 2)
     return chosen, table
+
+
+def threshold_undetermined(oof, sticky, ruled, undetermined, t):
+    """Where the rules could not decide, the lowest threshold, at most `t`, at which the
+    look-alikes turned out of fold (the `no_stiction` ones from `t`, the `undetermined` ones from
+    it) stay within the same limit."""
+    look = ~sticky
+    from_none = (~ruled & ~undetermined & (oof >= t))[look].sum()
+    for u in THRESHOLDS:
+        if u > t:
+            break
+        from_undetermined = (undetermined & (oof >= u))[look].sum()
+        if (from_none + from_undetermined) / look.sum() <= MOST_PROMOTED:
+            promoted = ~ruled & (oof >= t) | undetermined & (oof >= u)
+            return round(u, 2), int(promoted[sticky].sum()), int(promoted[look].sum())
+    return t, None, None
 
 
 def nodes(predictor):
@@ -172,12 +192,13 @@ def main():
     from sklearn.model_selection import StratifiedKFold, cross_val_predict
 
     out, paths = sys.argv[1], sys.argv[2:]
-    names, x, sticky, ruled = load(paths)
+    names, x, sticky, ruled, undetermined = load(paths)
     # folds drawn at random (seeded): without shuffling they would follow the files' order and
     # hold whole draws or kinds of loops out of some folds, and the threshold would hang on it
     folds = StratifiedKFold(FOLDS, shuffle=True, random_state=0)
     oof = cross_val_predict(model(), x, sticky, cv=folds, method="predict_proba")[:, 1]
     t, table = threshold(oof, sticky, ruled)
+    u, u_sticky, u_look = threshold_undetermined(oof, sticky, ruled, undetermined, t)
     m = model().fit(x, sticky)
     p = m.predict_proba(x)[:, 1]
     trees = [nodes(it[0]) for it in m._predictors]
@@ -190,12 +211,15 @@ def main():
         f"healthy look-alikes; the catalogue's calibration set and draws 1-3 and 10-29, routine and fast, and those draws' "
         f"external oscillations replaced by another loop's stiction cycle; never the benchmark sets, draws 4-9 or the "
         f"ISDB); threshold {t:.2f}: the lowest at which, out of fold (five seeded random folds), at most {100 * MOST_PROMOTED:.1f} % of the "
-        f"look-alikes would be turned to stiction (turned out of fold, at each threshold: {words})"
+        f"look-alikes would be turned to stiction (turned out of fold, at each threshold: {words}); where the rules are "
+        f"undetermined, from {u:.2f}: the lowest at which the look-alikes turned, with the others from {t:.2f}, stay within "
+        f"the same {100 * MOST_PROMOTED:.1f} % ({u_sticky} sticky, {u_look} look-alikes turned out of fold)"
     )
     forest = {
         "features": names,
         "baseline": float(np.ravel(m._baseline_prediction)[0]),
         "threshold": t,
+        "threshold_undetermined": u,
         "calibration": calibration,
         "trees": trees,
         "checks": checks,

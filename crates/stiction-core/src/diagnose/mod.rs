@@ -134,8 +134,10 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         samples: r.op.len(),
     });
     if let Some(c) = combined.as_mut() {
+        c.for_verdict(decision.verdict);
         if c.decides(decision.verdict, &families) {
             c.decided = true;
+            c.before = Some(decision.verdict);
             decision = verdict::decided_by_combination(decision, c, &families, &motion);
         }
         decision.evidence.push(c.line());

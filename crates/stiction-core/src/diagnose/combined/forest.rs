@@ -25,8 +25,12 @@ pub struct Forest {
     pub features: Vec<String>,
     /// The log-odds every tree adds to.
     pub baseline: f64,
-    /// The probability from which a verdict other than `stiction` becomes `stiction`.
+    /// The probability from which a `no_stiction` verdict becomes `stiction`.
     pub threshold: f64,
+    /// The probability from which an `undetermined` verdict becomes `stiction` (`threshold`
+    /// when absent).
+    #[serde(default)]
+    pub threshold_undetermined: Option<f64>,
     /// How the trees and the threshold were set, in words.
     pub calibration: String,
     pub trees: Vec<Vec<Node>>,
@@ -55,6 +59,17 @@ pub fn forest() -> Option<&'static Forest> {
 }
 
 impl Forest {
+    /// The probability from which the rules' `verdict` becomes `stiction`: where the rules could
+    /// not decide, the trees' lower threshold for `undetermined`.
+    pub fn threshold_for(&self, verdict: crate::diagnose::result::Verdict) -> f64 {
+        match verdict {
+            crate::diagnose::result::Verdict::Undetermined => {
+                self.threshold_undetermined.unwrap_or(self.threshold)
+            }
+            _ => self.threshold,
+        }
+    }
+
     /// The trees' probability for `x` (statistics in [`Forest::features`]' order), with each
     /// statistic's contribution to the log-odds. `None` when `x` has the wrong length or a
     /// tree points outside itself.

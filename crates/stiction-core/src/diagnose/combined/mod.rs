@@ -41,10 +41,14 @@ pub struct Statistic {
 pub struct CombinedEvidence {
     /// The trees' probability of a sticky valve.
     pub probability: f64,
-    /// From this probability a verdict other than `stiction` becomes `stiction`.
+    /// From this probability the rules' verdict becomes `stiction` (the trees' threshold for it:
+    /// lower where the rules are `undetermined` than where they say `no_stiction`).
     pub threshold: f64,
     /// Whether the trees turned the verdict to `stiction`.
     pub decided: bool,
+    /// The rules' verdict, when the trees turned it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub before: Option<Verdict>,
     /// Every statistic read, in the trees' order.
     pub statistics: Vec<Statistic>,
     /// How the trees and the threshold were set.
@@ -64,6 +68,7 @@ impl CombinedEvidence {
             probability: reading.probability,
             threshold: forest.threshold,
             decided: false,
+            before: None,
             statistics: features::NAMES
                 .iter()
                 .zip(x)
@@ -76,6 +81,13 @@ impl CombinedEvidence {
                 .collect(),
             calibration: forest.calibration.clone(),
         })
+    }
+
+    /// Hold the trees to their threshold for the rules' `verdict` (the forest's `threshold_for`).
+    pub fn for_verdict(&mut self, verdict: Verdict) {
+        if let Some(f) = forest() {
+            self.threshold = f.threshold_for(verdict);
+        }
     }
 
     /// Whether the trees turn `verdict` to `stiction`: their probability reaches the threshold,

@@ -54,6 +54,7 @@ fn evidence(probability: f64) -> super::CombinedEvidence {
         probability,
         threshold: 0.8,
         decided: false,
+        before: None,
         statistics: Vec::new(),
         calibration: String::new(),
     }
@@ -163,4 +164,26 @@ fn the_shape_indices_are_read_by_name_and_missing_ones_say_so() {
         "{words}"
     );
     assert!(NAMES.iter().filter(|n| n.2 == Scale::Index).count() == 6);
+}
+
+#[test]
+fn where_the_rules_are_undetermined_the_trees_decide_from_their_lower_threshold() {
+    use crate::diagnose::result::Verdict;
+    let f = forest().expect("trained trees are embedded");
+    let under = f
+        .threshold_undetermined
+        .expect("a threshold for undetermined verdicts");
+    assert!((0.5..=f.threshold).contains(&under), "{under}");
+    assert_eq!(f.threshold_for(Verdict::Undetermined), under);
+    assert_eq!(f.threshold_for(Verdict::NoStiction), f.threshold);
+    // a probability between the two turns an undetermined verdict, not a no_stiction one
+    let between = (under + f.threshold) / 2.0;
+    let quiet = [abstaining(crate::diagnose::evidence::Family::Valve)];
+    let mut e = evidence(between);
+    e.for_verdict(Verdict::Undetermined);
+    assert_eq!(e.threshold, under);
+    assert!(e.decides(Verdict::Undetermined, &quiet));
+    e.for_verdict(Verdict::NoStiction);
+    assert_eq!(e.threshold, f.threshold);
+    assert!(!e.decides(Verdict::NoStiction, &quiet));
 }
