@@ -5,6 +5,7 @@
 //! so a path's steps split the tree's output among the statistics it asked about (Saabas'
 //! contributions): the trees' log-odds are the baseline, the roots' means and those steps.
 
+use crate::diagnose::result::Verdict;
 use serde::Deserialize;
 use std::sync::LazyLock;
 
@@ -61,11 +62,9 @@ pub fn forest() -> Option<&'static Forest> {
 impl Forest {
     /// The probability from which the rules' `verdict` becomes `stiction`: where the rules could
     /// not decide, the trees' lower threshold for `undetermined`.
-    pub fn threshold_for(&self, verdict: crate::diagnose::result::Verdict) -> f64 {
+    pub fn threshold_for(&self, verdict: Verdict) -> f64 {
         match verdict {
-            crate::diagnose::result::Verdict::Undetermined => {
-                self.threshold_undetermined.unwrap_or(self.threshold)
-            }
+            Verdict::Undetermined => self.threshold_undetermined.unwrap_or(self.threshold),
             _ => self.threshold,
         }
     }
