@@ -41,6 +41,12 @@ fn the_levels_test_finds_the_band_of_a_sticky_valve_and_nothing_in_a_healthy_one
     let band = levels["band_percent_of_span"].as_f64().unwrap();
     assert!(ratio >= levels["threshold"].as_f64().unwrap(), "{m:#}");
     assert!((band - 2.0).abs() < 0.5, "{m:#}");
+    // a smaller band than the valve family counts would not vote (0.2 % of span)
+    assert_eq!(
+        levels["min_band_percent_of_span"].as_f64(),
+        Some(0.2),
+        "{m:#}"
+    );
     assert!(levels["trajectories"].as_u64().unwrap() > 10, "{m:#}");
     assert_eq!(m["vote"], "stiction", "{m:#}");
     assert!(m["note"].as_str().unwrap().contains("levels test"), "{m:#}");

@@ -113,7 +113,7 @@ impl<'a> Beside<'a> {
         let levels = family(Family::Model)
             .and_then(|f| f.model.as_ref())
             .and_then(|m| m.levels.as_ref())
-            .filter(|l| l.ratio >= l.threshold)
+            .filter(|l| l.sticky())
             .map(|l| l.band);
         let ellipse = (osc.oscillating)
             .then_some(osc.period)

@@ -16,7 +16,15 @@
 //! routine loops sticky. A PV that is not recorded over [`MAX_UNRECORDED`] of the record (historian
 //! compression, a frozen or coarsely quantised transmitter) is left out: a held PV is a staircase
 //! that a sticky valve's trajectory fits.
+//!
+//! A band under [`crate::diagnose::evidence::valve::MIN_BAND_PERCENT`] of span is not counted:
+//! where even the recorded valve position would not call so small a band stiction, PV's levels
+//! cannot. On the catalogue's routine windows with load steps the test's best valve was such a
+//! band (0.04-0.07 % of span, over OP's noise of 0.01-0.02 %) at ratios of 64 to 146, and one of
+//! them was called `stiction` for it; the sticky valves' bands it found were 0.2 % and more
+//! (`docs/accuracy-history.md`, 2026-11-29 evening).
 
+use super::super::valve::MIN_BAND_PERCENT;
 use super::super::Context;
 use crate::identify::levels::{levels_walk, LevelsWalk};
 use serde::{Deserialize, Serialize};
@@ -43,6 +51,17 @@ pub struct LevelsEvidence {
     pub trajectories: usize,
     /// The ratio at and above which the test votes stiction.
     pub threshold: f64,
+    /// The smallest band (% of span) the test counts: a smaller one never votes stiction.
+    #[serde(default)]
+    pub min_band_percent_of_span: f64,
+}
+
+impl LevelsEvidence {
+    /// Whether the test calls the valve sticky: the ratio at its threshold, with a band the
+    /// valve family would count.
+    pub fn sticky(&self) -> bool {
+        self.ratio >= self.threshold && self.band_percent_of_span >= self.min_band_percent_of_span
+    }
 }
 
 /// The outcome of the levels test on the analysed stretch.
@@ -82,6 +101,7 @@ impl LevelsTest {
                 slip_short,
                 trajectories,
                 threshold: LEVELS_STICTION,
+                min_band_percent_of_span: MIN_BAND_PERCENT,
             }),
             None => LevelsTest::Skipped(
                 "the levels test is not run: too few samples, or OP does not move".into(),
@@ -100,7 +120,7 @@ impl LevelsTest {
     /// The vote's strength when the test calls stiction.
     pub fn stiction_strength(&self) -> Option<f64> {
         let e = self.evidence()?;
-        (e.ratio >= LEVELS_STICTION).then(|| {
+        e.sticky().then(|| {
             (0.5 + 0.5 * (e.ratio / LEVELS_STICTION).ln()
                 / (LEVELS_DECISIVE / LEVELS_STICTION).ln())
             .min(1.0)
@@ -113,7 +133,7 @@ impl LevelsTest {
             LevelsTest::NotRun => None,
             LevelsTest::Skipped(why) => Some(why.clone()),
             LevelsTest::Ran(e) => Some(format!(
-                "levels test: {} explains PV's levels {} than OP (ratio {:.0} over {} valve trajectories; stiction at {LEVELS_STICTION:.0})",
+                "levels test: {} explains PV's levels {} than OP (ratio {:.0} over {} valve trajectories; stiction at {LEVELS_STICTION:.0}{})",
                 if e.slip_short > 0.0 {
                     format!(
                         "a band of {:.2} % of span whose slips land {:.2} % short of OP (He)",
@@ -125,8 +145,52 @@ impl LevelsTest {
                 },
                 if e.ratio >= LEVELS_STICTION { "far better" } else if e.ratio > 0.0 { "a little better" } else { "no better" },
                 e.ratio,
-                e.trajectories
+                e.trajectories,
+                if e.ratio >= LEVELS_STICTION && !e.sticky() {
+                    format!(
+                        ", with a band of at least {MIN_BAND_PERCENT} % of span: a smaller one is not counted"
+                    )
+                } else {
+                    String::new()
+                }
             )),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ran(ratio: f64, band_percent_of_span: f64) -> LevelsTest {
+        LevelsTest::Ran(LevelsEvidence {
+            ratio,
+            band: band_percent_of_span,
+            band_percent_of_span,
+            slip_short: 0.0,
+            trajectories: 100,
+            threshold: LEVELS_STICTION,
+            min_band_percent_of_span: MIN_BAND_PERCENT,
+        })
+    }
+
+    #[test]
+    fn a_band_the_valve_family_would_not_count_never_votes_stiction() {
+        // far over the ratio's threshold, but a band of 0.04 % of span
+        let small = ran(146.0, 0.04);
+        assert!(!small.evidence().unwrap().sticky());
+        assert_eq!(small.stiction_strength(), None);
+        assert!(
+            small.words().unwrap().contains("not counted"),
+            "{:?}",
+            small.words()
+        );
+        // the same ratio with a band at the floor counts, and says nothing of the floor
+        let counted = ran(146.0, MIN_BAND_PERCENT);
+        assert!(counted.evidence().unwrap().sticky());
+        assert!(counted.stiction_strength().unwrap() > 0.5);
+        assert!(!counted.words().unwrap().contains("not counted"));
+        // under the ratio's threshold nothing counts, whatever the band
+        assert_eq!(ran(49.0, 2.0).stiction_strength(), None);
     }
 }
