@@ -87,7 +87,7 @@ fn the_levels_test_finds_the_band_of_a_sticky_valve_and_nothing_in_a_healthy_one
         "{hidden:#}"
     );
     assert!(
-        hidden["threshold"].as_str().unwrap().contains("60"),
+        hidden["threshold"].as_str().unwrap().contains("75"),
         "{hidden:#}"
     );
 }

@@ -108,12 +108,13 @@ fn main() {
          ({particles} particles). The ratio (natural log) of a Stenman valve whose position the record does not hold \
          against a valve that follows OP, each hypothesis's loop model found by coordinate ascent from four processes \
          (see `stiction_core::hidden_valve`), beside `diagnose`'s verdict as the CLI gives it (without `--thorough`). The study behind \
-         `diagnose --thorough`'s hidden-valve family, which votes on the ratio from 60 where its gates let it judge.\n",
+         `diagnose --thorough`'s hidden-valve family, which votes on the ratio from {:.0} where its gates let it judge.\n",
         if arg(&args, "--set") == Some("calibration") {
             " --set calibration"
         } else {
             ""
-        }
+        },
+        stiction_core::diagnose::evidence::hidden_valve::THRESHOLD,
     );
     let sets = match arg(&args, "--set") {
         Some("calibration") => vec![Set::Calibration],

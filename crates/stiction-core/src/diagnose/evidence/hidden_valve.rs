@@ -25,8 +25,11 @@ pub struct HiddenValve;
 /// oscillation, compression and OP-range gates let through on the two calibration sets, rounded
 /// up to 5 (the routine windows' highest 58.5, a healthy valve under a load drift; the fast
 /// loops' 46.2, an external oscillation; with 100 particles and Box-Muller draws, before, 58.1
-/// and 53.6). The benchmark sets were judged at it after (docs/plant-benchmark-thorough.md).
-pub const THRESHOLD: f64 = 60.0;
+/// and 53.6), so 60 until the routine calibration set gained its look-alikes with load steps and
+/// with a fed-forward load (2026-11-27): one of those, a load step, reaches 74.1, so the same
+/// rule gives 75 (2026-11-29). The benchmark sets were judged at it after
+/// (docs/plant-benchmark-thorough.md, docs/accuracy-history.md).
+pub const THRESHOLD: f64 = 75.0;
 /// OP's travel (5th to 95th percentile, twice its amplitude) above this share of the valve span
 /// leaves the family silent: on the routine calibration windows an equal-percentage valve under a
 /// load ramp (OP over 14 % of span) reached a ratio of 288; the sticky valves the family found

@@ -1,6 +1,7 @@
 //! `thorough`: the levels test and the hidden valve.
 
 use super::*;
+use stiction_core::diagnose::evidence::hidden_valve::THRESHOLD;
 
 #[test]
 fn thorough_finds_a_valve_the_fit_of_changes_misses_and_reports_its_band() {
@@ -37,7 +38,7 @@ fn thorough_finds_a_valve_that_slips_between_the_samples() {
     assert_eq!(hidden.vote, Vote::Stiction, "{}", hidden.note);
     let h = hidden.hidden_valve.as_ref().unwrap();
     assert!(
-        h.ratio >= 60.0 && (0.5..4.0).contains(&h.band_percent_of_span),
+        h.ratio >= THRESHOLD && (0.5..4.0).contains(&h.band_percent_of_span),
         "{h:?}"
     );
     // a first ratio past the threshold is drawn three times in all; the median decides
@@ -95,6 +96,6 @@ fn a_hidden_valve_ratio_under_the_threshold_is_drawn_once() {
     let hidden = hidden_valve_of(&d);
     assert_eq!(hidden.vote, Vote::Undetermined, "{}", hidden.note);
     let h = hidden.hidden_valve.as_ref().unwrap();
-    assert!(h.ratio < 60.0, "{h:?}");
+    assert!(h.ratio < THRESHOLD, "{h:?}");
     assert_eq!(h.draws, vec![h.ratio], "{h:?}");
 }
