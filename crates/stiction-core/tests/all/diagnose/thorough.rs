@@ -84,18 +84,46 @@ fn a_hidden_valve_ratio_under_the_threshold_is_drawn_once() {
     // fast-b-0135 of the catalogue's benchmark set: a healthy valve under an external
     // oscillation. The hidden valve judges it, finds no sticky valve worth a vote, and does not
     // draw the particle filter's noise again
-    let l = stiction_core::sim::catalogue::find("fast-b-0135").unwrap();
-    let req = DiagnoseRequest {
-        ts: l.ts(),
-        integrating: l.integrating,
-        thorough: true,
-        ..DiagnoseRequest::default()
-    };
-    let d = diagnose(&record(&l.data), &req).unwrap();
+    let d = thorough_diagnosis("fast-b-0135");
     assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
     let hidden = hidden_valve_of(&d);
     assert_eq!(hidden.vote, Vote::Undetermined, "{}", hidden.note);
     let h = hidden.hidden_valve.as_ref().unwrap();
     assert!(h.ratio < THRESHOLD, "{h:?}");
     assert_eq!(h.draws, vec![h.ratio], "{h:?}");
+}
+
+#[test]
+fn a_band_the_levels_test_fits_to_a_clock_regular_input_is_no_vote() {
+    // routine-c-0465 of the catalogue's calibration set: a healthy pressure valve under a sine on
+    // the load, a cycle that keeps time like a clock (regularity about 125). The fit of PV's
+    // changes finds a band, but over whole periods no band gains, so its vote is withdrawn; the
+    // levels test's band fits the same cycle (ratio over its threshold) and is no vote either.
+    let d = thorough_diagnosis("routine-c-0465");
+    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let m = d
+        .families
+        .iter()
+        .find(|f| f.family == Family::Model)
+        .unwrap();
+    assert_eq!(m.vote, Vote::Undetermined, "{}", m.note);
+    let levels = m.model.as_ref().unwrap().levels.as_ref().unwrap();
+    assert!(levels.sticky(), "{levels:?}");
+    assert!(
+        m.note.contains("the levels test's is no vote"),
+        "{}",
+        m.note
+    );
+}
+
+/// The catalogue loop `id` diagnosed with `thorough`, as the CLI judges it.
+fn thorough_diagnosis(id: &str) -> stiction_core::diagnose::Diagnosis {
+    let l = stiction_core::sim::catalogue::find(id).unwrap();
+    let req = DiagnoseRequest {
+        ts: l.ts(),
+        integrating: l.integrating,
+        thorough: true,
+        ..DiagnoseRequest::default()
+    };
+    diagnose(&record(&l.data), &req).unwrap()
 }

@@ -2,9 +2,11 @@
 
 use super::{
     loop_gain, unprovoked, CycleCancelled, CycleShape, Levels, LevelsEvidence, Unprovoked,
-    CALIBRATION, CYCLE_CANCELLED_STICTION, FIT_HARMONICS, FOREIGN_SHAPE, LEVELS_STICTION,
-    LIMIT_CYCLE_REGULARITY, MIN_EXPLAINED, MIN_LOOP_GAIN, SIGNIFICANCE_NONE, SIGNIFICANCE_STICTION,
+    CALIBRATION, CYCLE_CANCELLED_STICTION, FIT_HARMONICS, FORCED_REGULARITY, FOREIGN_SHAPE,
+    LEVELS_STICTION, LIMIT_CYCLE_REGULARITY, MIN_EXPLAINED, MIN_LOOP_GAIN, SIGNIFICANCE_NONE,
+    SIGNIFICANCE_STICTION,
 };
+use crate::diagnose::evidence::valve::MIN_BAND_PERCENT;
 use crate::diagnose::evidence::Context;
 use crate::identify::Structure;
 use crate::quantify::{FitComparison, OverLag};
@@ -230,7 +232,9 @@ pub(super) fn threshold_words(thorough: bool) -> String {
     if thorough {
         format!(
             "{threshold}; or the levels test's ratio (the best Stenman valve against OP on PV's levels) reaches {LEVELS_STICTION} \
-             (about the 98th percentile of simulated healthy loops), unless OP explains under {:.0} %",
+             (about the 98th percentile of simulated healthy loops) with a band of at least {MIN_BAND_PERCENT} % of span, unless OP \
+             explains under {:.0} % or the cycle keeps time like an input of fixed period (regularity {FORCED_REGULARITY} or more) \
+             and over whole periods no band gains",
             100.0 * MIN_EXPLAINED
         )
     } else {
