@@ -26,7 +26,9 @@
 
 use super::super::valve::MIN_BAND_PERCENT;
 use super::super::Context;
+use super::{clock_regular, CycleCancelled, ModelEvidence};
 use crate::identify::levels::{levels_walk, LevelsWalk};
+use crate::quantify::FitComparison;
 use serde::{Deserialize, Serialize};
 
 /// The levels test's ratio at and above which it votes stiction.
@@ -156,6 +158,32 @@ impl LevelsTest {
             )),
         }
     }
+}
+
+/// Where the levels test finds a band on a cycle as regular as an input of fixed period and the
+/// fits compared over whole periods find nothing a band explains beyond what healthy loops give,
+/// the band's gain on PV's levels is the cycle's alone, as the first comparison's is in that case
+/// (`FORCED_REGULARITY`): why the levels test's is then no vote. `None` where it counts.
+pub(super) fn cycle_alone(
+    ctx: &Context,
+    f: &FitComparison,
+    evidence: &mut ModelEvidence,
+) -> Option<String> {
+    if !clock_regular(ctx) {
+        return None;
+    }
+    let fresh = evidence.cycle_cancelled.is_none();
+    if fresh {
+        evidence.cycle_cancelled = CycleCancelled::of(ctx, f);
+    }
+    let c = evidence.cycle_cancelled.as_ref()?;
+    c.only_the_cycle().then(|| {
+        format!(
+            "the levels test finds a band, but the cycle keeps time like an input of fixed period (regularity {:.0}){}: a band fits such an input's cycle too, so the levels test's is no vote",
+            ctx.oscillation.regularity.regularity,
+            if fresh { format!(", and {}", c.words()) } else { ", and over whole periods no band gains".into() }
+        )
+    })
 }
 
 #[cfg(test)]

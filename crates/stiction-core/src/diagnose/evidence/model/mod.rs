@@ -237,7 +237,7 @@ impl EvidenceFamily for Model {
         }
         if vote != Vote::Stiction && levels.explained >= MIN_EXPLAINED {
             if let Some(s) = test.stiction_strength() {
-                match levels_cycle_alone(ctx, f, &mut evidence) {
+                match levels::cycle_alone(ctx, f, &mut evidence) {
                     Some(w) => why = format!("{why}; {w}"),
                     None => {
                         why = format!("the levels test finds a sticky valve where the fit of PV's changes does not ({why})");
@@ -294,32 +294,6 @@ fn test_strength(significance: f64) -> f64 {
     (0.5 + 0.5 * (significance / SIGNIFICANCE_STICTION).ln()
         / (SIGNIFICANCE_DECISIVE / SIGNIFICANCE_STICTION).ln())
     .min(1.0)
-}
-
-/// Where the levels test finds a band on a cycle as regular as an input of fixed period and the
-/// fits compared over whole periods find nothing a band explains beyond what healthy loops give,
-/// the band's gain on PV's levels is the cycle's alone, as the first comparison's is in that case
-/// (`FORCED_REGULARITY`): why the levels test's is then no vote. `None` where it counts.
-fn levels_cycle_alone(
-    ctx: &Context,
-    f: &FitComparison,
-    evidence: &mut ModelEvidence,
-) -> Option<String> {
-    if !clock_regular(ctx) {
-        return None;
-    }
-    let fresh = evidence.cycle_cancelled.is_none();
-    if fresh {
-        evidence.cycle_cancelled = CycleCancelled::of(ctx, f);
-    }
-    let c = evidence.cycle_cancelled.as_ref()?;
-    c.only_the_cycle().then(|| {
-        format!(
-            "the levels test finds a band, but the cycle keeps time like an input of fixed period (regularity {:.0}){}: a band fits such an input's cycle too, so the levels test's is no vote",
-            ctx.oscillation.regularity.regularity,
-            if fresh { format!(", and {}", c.words()) } else { ", and over whole periods no band gains".into() }
-        )
-    })
 }
 
 /// The vote, its strength and why, from the fits' levels.
