@@ -8,9 +8,14 @@
 //! runs only with `thorough`, only where the other families have not already decided `stiction`,
 //! and only where it was calibrated: an oscillating loop, PV recorded (not compressed, not
 //! quantised), OP moving over a narrow range (a valve's characteristic is not linear over a wide
-//! one, and the hidden valve's slips then absorb the linear loop's misfit). It votes stiction or
-//! not at all: a sticky valve's ratio can be small, so a small ratio is no evidence against it.
+//! one, and the hidden valve's slips then absorb the linear loop's misfit), and OP free of steps
+//! the control error did not provoke (`model::unprovoked`: a feed-forward's steps, through which
+//! a valve that sticks explains PV's stillness, as for the closed-loop fit; on a routine draw a
+//! fed-forward load reached a ratio of 253, and no sticky loop of the catalogue's sets has such a
+//! step). It votes stiction or not at all: a sticky valve's ratio can be small, so a small ratio
+//! is no evidence against it.
 
+use super::model::{unprovoked, Unprovoked};
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
 use crate::diagnose::oscillation::amplitude;
 use crate::diagnose::result::Vote;
@@ -126,7 +131,18 @@ fn gated(ctx: &Context) -> Option<String> {
             100.0 * MAX_OP_TRAVEL
         ))
     } else {
-        None
+        // as the closed-loop fit's vote is withdrawn there: a valve that sticks through OP's
+        // unprovoked steps explains PV's stillness under a fed-forward load
+        unprovoked(ctx.op, &ctx.error, ctx.pv_noise)
+            .filter(Unprovoked::withdraws)
+            .map(|u| {
+                format!(
+                    "OP makes {} steps the control error did not provoke ({:.0} % of its travel: a feed-forward, an override or an operator), \
+                     through which a valve that sticks explains PV's stillness",
+                    u.steps,
+                    100.0 * u.share
+                )
+            })
     }
 }
 

@@ -127,3 +127,17 @@ fn thorough_diagnosis(id: &str) -> stiction_core::diagnose::Diagnosis {
     };
     diagnose(&record(&l.data), &req).unwrap()
 }
+
+#[test]
+fn the_hidden_valve_does_not_judge_through_op_steps_the_error_did_not_provoke() {
+    // routine-x4-0536 of the catalogue's fourth further draw: a healthy valve under a fed-forward
+    // load. OP steps with the load while PV stays put; a hidden valve that sticks through those
+    // steps explained PV far better than OP (a ratio of 253). Like the closed-loop fit's vote,
+    // the hidden valve does not judge there.
+    let d = thorough_diagnosis("routine-x4-0536");
+    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    let hidden = hidden_valve_of(&d);
+    assert_eq!(hidden.vote, Vote::Undetermined, "{}", hidden.note);
+    assert!(hidden.note.contains("did not provoke"), "{}", hidden.note);
+    assert!(hidden.hidden_valve.is_none());
+}
