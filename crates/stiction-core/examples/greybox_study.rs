@@ -11,7 +11,11 @@
 //! dynamics refitted at a coarse grid of bands and held on the fine one. The statistic: the best
 //! sticky valve's log-likelihood against the valve that follows OP.
 //!
-//!     cargo run --release -p stiction-core --example greybox_study -- [--suite routine|fast] [--benchmark | --extra N] [--out FILE] [--jsonl FILE]
+//!     cargo run --release -p stiction-core --example greybox_study -- [--suite routine|fast] [--benchmark | --extra N] [--steps-only | --setpoint] [--out FILE] [--jsonl FILE]
+//!
+//! `--steps-only` judges only the records whose setpoint steps; `--setpoint` judges those with the
+//! grid held to 0.25-4 times the time constant, dead time and gain of the process identified from
+//! the setpoint (`common/setpoint.rs`; docs/accuracy-history.md, "the process from the setpoint").
 //!
 //! The threshold is the 97.5th percentile of the not-sticky loops' statistic, historian-compressed
 //! PVs left out (`diagnose` recognises them and runs no levels test on them). Slow on purpose
@@ -19,10 +23,13 @@
 
 #[path = "common/catalogue_loop.rs"]
 mod catalogue_loop;
+#[path = "common/setpoint.rs"]
+mod setpoint;
 #[path = "common/study_args.rs"]
 mod study_args;
 
 use rayon::prelude::*;
+use setpoint::Region;
 use std::fmt::Write as _;
 use stiction_core::diagnose::{diagnose, Verdict};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, LoopClass, Suite, Truth};
@@ -126,7 +133,7 @@ impl Filter {
 
     /// The concentrated log-likelihood with the valve `u` (centred), K and the noise's variance
     /// profiled out.
-    fn ll(&self, u: &[f64]) -> f64 {
+    fn ll(&self, u: &[f64], gain: Option<(f64, f64)>) -> f64 {
         let (a, c, bf) = (self.a, self.c, self.bf);
         let mut x = [0.0f64; 3];
         let (mut s00, mut s0g, mut sgg, mut sl) = (0.0, 0.0, 0.0, 0.0);
@@ -155,7 +162,15 @@ impl Filter {
             x = [a * x[0] + c * x[1] + bf * ut, x[1] + x[2], x[2]];
         }
         let kk = if sgg > 0.0 { s0g / sgg } else { 0.0 };
-        let s1 = (s00 - kk * s0g).max(1e-300);
+        let s1 = match gain {
+            // the gain held to its range: the sum of squares at the clamped gain
+            Some((lo, hi)) => {
+                let kk = kk.clamp(lo, hi);
+                s00 - 2.0 * kk * s0g + kk * kk * sgg
+            }
+            None => s00 - kk * s0g,
+        }
+        .max(1e-300);
         -0.5 * m as f64 * (s1 / m as f64).ln() - 0.5 * sl - 0.5 * m as f64
     }
 }
@@ -164,21 +179,32 @@ const TAUS: usize = 14;
 const QS: usize = 9;
 
 /// The best (theta, ln tau, ln q) on a grid for the valve `u`, among `thetas`.
-fn grid_fit(y: &[f64], u: &[f64], integ: bool, thetas: &[usize]) -> (f64, usize, f64, f64) {
+fn grid_fit(
+    y: &[f64],
+    u: &[f64],
+    integ: bool,
+    thetas: &[usize],
+    region: Option<&Region>,
+) -> (f64, usize, f64, f64) {
     let mut best = (f64::NEG_INFINITY, 0, 0.0, 0.0);
     let taus: Vec<f64> = if integ {
         vec![0.0]
     } else {
-        (0..TAUS)
+        let all: Vec<f64> = (0..TAUS)
             .map(|i| (0.3f64).ln() + i as f64 / (TAUS - 1) as f64 * (1000.0f64).ln())
-            .collect()
+            .collect();
+        match region {
+            Some(r) => r.taus(&all),
+            None => all,
+        }
     };
+    let gain = region.map(|r| r.gain);
     for &th in thetas {
         for &lt in &taus {
             for j in 0..QS {
                 let lq = (1e-9f64).ln() + j as f64 / (QS - 1) as f64 * (1e8f64).ln();
                 let f = Filter::new(y, integ, th, lt, lq);
-                let l = f.ll(u);
+                let l = f.ll(u, gain);
                 if l > best.0 {
                     best = (l, th, lt, lq);
                 }
@@ -202,7 +228,7 @@ fn kano(op: &[f64], s: f64, j: f64, out: &mut [f64]) {
     }
 }
 
-fn judge(l: &BenchmarkLoop) -> Row {
+fn judge(l: &BenchmarkLoop, region: Option<&Region>) -> Row {
     let d = &l.data;
     let n = d.op.len();
     let mop = d.op.iter().sum::<f64>() / n as f64;
@@ -210,8 +236,9 @@ fn judge(l: &BenchmarkLoop) -> Row {
     let y: Vec<f64> = d.pv.iter().map(|v| v - mpv).collect();
     let u: Vec<f64> = d.op.iter().map(|v| v - mop).collect();
     let integ = l.integrating;
-    let (l0, th, lt, lq) = grid_fit(&y, &u, integ, &DELAYS);
-    let near: Vec<usize> = DELAYS
+    let delays = region.map_or(DELAYS.to_vec(), |r| r.delays(&DELAYS));
+    let (l0, th, lt, lq) = grid_fit(&y, &u, integ, &delays, region);
+    let near: Vec<usize> = delays
         .iter()
         .copied()
         .filter(|&t| t + 3 >= th && t <= th + 3)
@@ -228,13 +255,14 @@ fn judge(l: &BenchmarkLoop) -> Row {
         for (c, v) in centred.iter_mut().zip(&valve) {
             *c = v - mop;
         }
-        let fit = grid_fit(&y, &centred, integ, &near);
+        let fit = grid_fit(&y, &centred, integ, &near, region);
         if fit.0 > coarse.0 {
             coarse = fit;
         }
     }
     let filter = Filter::new(&y, integ, coarse.1, coarse.2, coarse.3);
-    let l0_held = filter.ll(&u);
+    let gain = region.map(|r| r.gain);
+    let l0_held = filter.ll(&u, gain);
     let mut fine = Vec::new();
     let mut best = (f64::NEG_INFINITY, 0.0, 0.0);
     for &r in &RATIOS {
@@ -244,7 +272,7 @@ fn judge(l: &BenchmarkLoop) -> Row {
             for (c, v) in centred.iter_mut().zip(&valve) {
                 *c = v - mop;
             }
-            let v = filter.ll(&centred) - l0;
+            let v = filter.ll(&centred, gain) - l0;
             if v > best.0 {
                 best = (v, b, r);
             }
@@ -341,8 +369,17 @@ fn main() {
         None => args.set(),
     };
     let suite = args.suite();
-    let loops = catalogue::catalogue(suite, set);
-    let rows: Vec<Row> = loops.par_iter().map(judge).collect();
+    let mut loops = catalogue::catalogue(suite, set);
+    // `--steps-only`: the loops whose setpoint steps; `--setpoint`: those, with the process held
+    // near the one identified from the setpoint (`Region`)
+    let around = args.has("--setpoint");
+    if around || args.has("--steps-only") {
+        loops.retain(|l| Region::of(l).is_some());
+    }
+    let rows: Vec<Row> = loops
+        .par_iter()
+        .map(|l| judge(l, around.then(|| Region::of(l)).flatten().as_ref()))
+        .collect();
     if let Some(path) = args.value("--jsonl") {
         let lines: Vec<&str> = rows.iter().map(|r| r.json.as_str()).collect();
         std::fs::write(path, lines.join("\n") + "\n")

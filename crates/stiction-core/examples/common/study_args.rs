@@ -28,6 +28,12 @@ impl StudyArgs {
             .map(String::as_str)
     }
 
+    /// Whether `flag` was given.
+    #[allow(dead_code)]
+    pub fn has(&self, flag: &str) -> bool {
+        self.args.iter().any(|a| a == flag)
+    }
+
     /// The catalogue set: the benchmark seeds with `--benchmark`, else the calibration seeds.
     #[allow(dead_code)]
     pub fn set(&self) -> Set {
