@@ -189,6 +189,7 @@ pub(super) fn sticky_optimum(
         Coordinate::Cycle,
         Coordinate::Drift,
         Coordinate::CycleRadius,
+        Coordinate::CycleAngle,
         Coordinate::Gain,
         Coordinate::Tau,
         Coordinate::Delay,

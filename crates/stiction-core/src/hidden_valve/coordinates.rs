@@ -14,6 +14,7 @@ pub(super) enum Coordinate {
     Drift,
     Cycle,
     CycleRadius,
+    CycleAngle,
 }
 
 pub(super) const PROCESS: [Coordinate; 4] = [
@@ -22,19 +23,21 @@ pub(super) const PROCESS: [Coordinate; 4] = [
     Coordinate::Delay,
     Coordinate::ValveLag,
 ];
-pub(super) const LOADS: [Coordinate; 4] = [
+pub(super) const LOADS: [Coordinate; 5] = [
     Coordinate::Noise,
     Coordinate::Drift,
     Coordinate::Cycle,
     Coordinate::CycleRadius,
+    Coordinate::CycleAngle,
 ];
 
 /// The scales a search is relative to: sampling time, PV's sample-to-sample noise, the sign of
-/// the process gain.
+/// the process gain, and the cycling load's angles (radians per sample) to choose from.
 pub(super) struct Scales {
     pub ts: f64,
     pub noise: f64,
     pub sign: f64,
+    pub angles: Vec<f64>,
 }
 
 pub(super) fn values(c: Coordinate, s: &Scales) -> Vec<f64> {
@@ -48,6 +51,7 @@ pub(super) fn values(c: Coordinate, s: &Scales) -> Vec<f64> {
         Coordinate::Drift => times(&[1e-4, 1e-3, 0.01, 0.03, 0.1, 0.3, 1.0], s.noise),
         Coordinate::Cycle => times(&[0.0, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0], s.noise),
         Coordinate::CycleRadius => vec![0.8, 0.9, 0.97, 0.995],
+        Coordinate::CycleAngle => s.angles.clone(),
     }
 }
 
@@ -61,6 +65,7 @@ pub(super) fn set(m: &mut LoopModel, c: Coordinate, v: f64) {
         Coordinate::Drift => m.drift = v,
         Coordinate::Cycle => m.cycle = v,
         Coordinate::CycleRadius => m.cycle_radius = v,
+        Coordinate::CycleAngle => m.cycle_angle = v,
     }
 }
 

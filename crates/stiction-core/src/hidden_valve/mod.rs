@@ -8,7 +8,9 @@
 //! and each with the loop's state filtered exactly (the loop is linear and Gaussian given the
 //! valve). Against it, a Kalman filter with the valve following OP and the same unrecorded moves
 //! of OP as input noise. Both share one loop model ([`LoopModel`]): valve lag, first-order process
-//! or integrator, dead time, a drifting and a cycling load, measurement noise; its parameters are
+//! or integrator, dead time, a drifting and a cycling load (at PV's strongest cycle, or at the
+//! cycle the loop shows when the caller knows it: [`TestSettings::cycle_period`]), measurement
+//! noise; its parameters are
 //! found by coordinate ascent on each hypothesis's likelihood ([`fn@test`]), and the healthy one is
 //! searched again from the sticky one's optimum, so the ratio is never an artefact of a search
 //! that stopped short.

@@ -31,6 +31,10 @@ pub struct TestSettings {
     /// Valves each sticky search starts from at its healthy optimum: 1, the scan's best; 2, also
     /// the best whose band lies more than a grid step from it (another basin).
     pub band_starts: usize,
+    /// The period, samples, of the cycle the record shows, when the caller knows it: the
+    /// cycling load may sit there as well as at PV's strongest cycle (its periodogram's peak,
+    /// which setpoint steps can outweigh). `None`: at PV's strongest cycle only.
+    pub cycle_period: Option<f64>,
 }
 
 impl Default for TestSettings {
@@ -45,6 +49,7 @@ impl Default for TestSettings {
             sticky_starts: 2,
             short_shares: &[0.0],
             band_starts: 1,
+            cycle_period: None,
         }
     }
 }
@@ -88,10 +93,21 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
     } else {
         *rec
     };
+    // the cycling load at PV's strongest cycle, or at the cycle the loop shows (setpoint steps
+    // can outweigh an oscillation in PV's periodogram): each hypothesis takes the likelier
+    let strongest = cycle_angle(rec.pv);
+    let mut angles = vec![strongest];
+    if let Some(p) = set.cycle_period.filter(|p| *p > 2.0) {
+        let shown = std::f64::consts::TAU / p;
+        if shown != strongest {
+            angles.push(shown);
+        }
+    }
     let scales = Scales {
         ts: rec.ts,
         noise: step_noise(rec.pv),
         sign: gain_sign(rec.op, rec.pv),
+        angles,
     };
     if scales.noise.is_nan() || scales.noise <= 0.0 {
         return None;
@@ -106,7 +122,7 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
         drift: 0.01 * scales.noise,
         cycle: 0.0,
         cycle_radius: 0.95,
-        cycle_angle: cycle_angle(rec.pv),
+        cycle_angle: strongest,
         input_noise: set.input_noise * step_noise(rec.op),
     };
     let all: Vec<Coordinate> = PROCESS.iter().chain(&LOADS).copied().collect();
