@@ -208,37 +208,35 @@ impl Region {
 
     /// The grid's time constants inside the region, or the nearest one.
     pub fn taus(&self, all: &[f64]) -> Vec<f64> {
-        let inside: Vec<f64> = all
-            .iter()
-            .copied()
-            .filter(|t| (self.ln_tau.0..=self.ln_tau.1).contains(t))
-            .collect();
-        if !inside.is_empty() {
-            return inside;
-        }
-        let mid = 0.5 * (self.ln_tau.0 + self.ln_tau.1);
-        vec![all
-            .iter()
-            .copied()
-            .min_by(|a, b| (a - mid).abs().total_cmp(&(b - mid).abs()))
-            .unwrap_or(mid)]
+        inside_or_nearest(all, self.ln_tau, |&t| t)
     }
 
     /// The grid's delays inside the region, or the nearest one.
     pub fn delays(&self, all: &[usize]) -> Vec<usize> {
-        let inside: Vec<usize> = all
-            .iter()
-            .copied()
-            .filter(|&t| (self.delay.0..=self.delay.1).contains(&(t as f64)))
-            .collect();
-        if !inside.is_empty() {
-            return inside;
-        }
-        let mid = 0.5 * (self.delay.0 + self.delay.1);
-        vec![all
-            .iter()
-            .copied()
-            .min_by(|a, b| (*a as f64 - mid).abs().total_cmp(&(*b as f64 - mid).abs()))
-            .unwrap_or(0)]
+        inside_or_nearest(all, self.delay, |&t| t as f64)
     }
+}
+
+/// The grid points whose value lies in `(lo, hi)`, or the one nearest its middle.
+#[allow(dead_code)]
+fn inside_or_nearest<T: Copy>(
+    all: &[T],
+    (lo, hi): (f64, f64),
+    value: impl Fn(&T) -> f64,
+) -> Vec<T> {
+    let inside: Vec<T> = all
+        .iter()
+        .copied()
+        .filter(|t| (lo..=hi).contains(&value(t)))
+        .collect();
+    if !inside.is_empty() {
+        return inside;
+    }
+    let mid = 0.5 * (lo + hi);
+    let distance = |t: &T| (value(t) - mid).abs();
+    all.iter()
+        .copied()
+        .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+        .into_iter()
+        .collect()
 }
