@@ -86,7 +86,7 @@ pub(super) fn step_noise(x: &[f64]) -> f64 {
 
 /// The angle (radians per sample) of PV's strongest cycle: the peak of its periodogram, the
 /// slowest few frequencies left out.
-pub(super) fn cycle_angle(pv: &[f64]) -> f64 {
+fn cycle_angle(pv: &[f64]) -> f64 {
     let n = pv.len();
     let mean = pv.iter().sum::<f64>() / n as f64;
     let (mut best, mut angle) = (0.0, std::f64::consts::PI / 8.0);
@@ -105,6 +105,21 @@ pub(super) fn cycle_angle(pv: &[f64]) -> f64 {
         }
     }
     angle
+}
+
+/// The cycling load's angles to choose from: PV's strongest cycle first, then the cycle the loop
+/// shows (its period in samples, when the caller knows it), where they differ. Setpoint steps can
+/// outweigh an oscillation in PV's periodogram; each hypothesis takes the likelier.
+pub(super) fn cycle_angles(pv: &[f64], shown_period: Option<f64>) -> Vec<f64> {
+    let strongest = cycle_angle(pv);
+    let mut angles = vec![strongest];
+    if let Some(p) = shown_period.filter(|p| *p > 2.0) {
+        let shown = std::f64::consts::TAU / p;
+        if shown != strongest {
+            angles.push(shown);
+        }
+    }
+    angles
 }
 
 /// The sign of the process gain: of the correlation of PV's changes with OP's a few samples

@@ -1,7 +1,7 @@
 //! The likelihood ratio with each hypothesis's loop model found by coordinate ascent.
 
 use super::ascent::{ascend, band_starts, remembered, sticky_optimum, Grid};
-use super::coordinates::{cycle_angle, gain_sign, step_noise, Coordinate, Scales, LOADS, PROCESS};
+use super::coordinates::{cycle_angles, gain_sign, step_noise, Coordinate, Scales, LOADS, PROCESS};
 use super::likelihood::{healthy_log_likelihood, sticky_log_likelihood, Particles, Record, Slip};
 use super::model::LoopModel;
 use rayon::prelude::*;
@@ -93,16 +93,8 @@ pub fn test(rec: &Record, set: &TestSettings) -> Option<HiddenValveTest> {
     } else {
         *rec
     };
-    // the cycling load at PV's strongest cycle, or at the cycle the loop shows (setpoint steps
-    // can outweigh an oscillation in PV's periodogram): each hypothesis takes the likelier
-    let strongest = cycle_angle(rec.pv);
-    let mut angles = vec![strongest];
-    if let Some(p) = set.cycle_period.filter(|p| *p > 2.0) {
-        let shown = std::f64::consts::TAU / p;
-        if shown != strongest {
-            angles.push(shown);
-        }
-    }
+    let angles = cycle_angles(rec.pv, set.cycle_period);
+    let strongest = angles[0];
     let scales = Scales {
         ts: rec.ts,
         noise: step_noise(rec.pv),
