@@ -94,6 +94,13 @@ fn by_setpoint(l: &BenchmarkLoop, d: &LoopData) -> Option<Foptd> {
     process_from(&u, &d.pv, l.setup.ts, l.integrating)
 }
 
+/// A record's process as each identification gives it.
+#[derive(Clone, Copy)]
+struct Ids {
+    fit: Option<Foptd>,
+    setpoint: Option<Foptd>,
+}
+
 /// A group of rows for the first table: its name's rule.
 type Group = Box<dyn Fn(&Row) -> bool>;
 
@@ -130,7 +137,7 @@ fn with_process(l: &BenchmarkLoop, setup: &ClosedLoop, p: Foptd) -> ClosedLoop {
 
 /// The "recorded" oracle (load's model known, PV at the recorded samples; band known but in the last three rows) on a sticky
 /// loop and its twin under the true process, the fit's and the setpoint's.
-fn oracle(l: &BenchmarkLoop) -> Option<[(f64, f64); 9]> {
+fn oracle(l: &BenchmarkLoop, ids: Ids) -> Option<[(f64, f64); 9]> {
     if !matches!(l.truth, catalogue::Truth::Sticky) {
         return None;
     }
@@ -141,9 +148,10 @@ fn oracle(l: &BenchmarkLoop) -> Option<[(f64, f64); 9]> {
     let twin_data = twin.run().ok()?;
     let llr = |s: &ClosedLoop, r: &kalman::FullRun| kalman::llrs(s, &l.setup.model, r).recorded;
     let truth = (llr(&l.setup, &run), llr(&twin, &twin_run));
-    let under = |f: fn(&BenchmarkLoop, &LoopData) -> Option<Foptd>| -> Option<(f64, f64)> {
-        let p1 = f(l, &l.data)?;
-        let p0 = f(l, &twin_data)?;
+    // each identification once, of the loop's record and of its twin's
+    let fit = (ids.fit?, by_fit(l, &twin_data)?);
+    let setpoint = (ids.setpoint?, by_setpoint(l, &twin_data)?);
+    let under = |(p1, p0): (Foptd, Foptd)| -> Option<(f64, f64)> {
         Some((
             llr(&with_process(l, &l.setup, p1), &run),
             llr(&with_process(l, &twin, p0), &twin_run),
@@ -151,22 +159,21 @@ fn oracle(l: &BenchmarkLoop) -> Option<[(f64, f64); 9]> {
     };
     // each hypothesis its own process, from the setpoint: a generalised likelihood ratio
     let healthy = Model::Stenman(Stenman { d: 0.0 });
-    let glr = |d: &LoopData, setup: &ClosedLoop, r: &kalman::FullRun| -> Option<f64> {
+    let glr = |d: &LoopData, setup: &ClosedLoop, r: &kalman::FullRun, p0: Foptd| -> Option<f64> {
         let p1 = by_setpoint_under(l, d, &l.setup.model)?;
-        let p0 = by_setpoint(l, d)?;
         Some(
             profile::recorded_log_likelihood(&with_process(l, setup, p1), &l.setup.model, r)
                 - profile::recorded_log_likelihood(&with_process(l, setup, p0), &healthy, r),
         )
     };
     let each = (
-        glr(&l.data, &l.setup, &run)?,
-        glr(&twin_data, &twin, &twin_run)?,
+        glr(&l.data, &l.setup, &run, setpoint.0)?,
+        glr(&twin_data, &twin, &twin_run, setpoint.1)?,
     );
     // the wide profile (band known) centred on each identification's process
-    let centred = |f: fn(&BenchmarkLoop, &LoopData) -> Option<Foptd>| -> Option<(f64, f64)> {
-        let s1 = with_process(l, &l.setup, f(l, &l.data)?);
-        let s0 = with_process(l, &twin, f(l, &twin_data)?);
+    let centred = |(p1, p0): (Foptd, Foptd)| -> Option<(f64, f64)> {
+        let s1 = with_process(l, &l.setup, p1);
+        let s0 = with_process(l, &twin, p0);
         Some((
             profile::profiled_llr(&s1, &l.setup.model, &run, &profile::WIDE),
             profile::profiled_llr(&s0, &l.setup.model, &twin_run, &profile::WIDE),
@@ -174,32 +181,31 @@ fn oracle(l: &BenchmarkLoop) -> Option<[(f64, f64); 9]> {
     };
     // with the band free too (16 Stenman bands at every point), on the Stenman loops; and with
     // the noise as the record shows it
-    let free =
-        |f: fn(&BenchmarkLoop, &LoopData) -> Option<Foptd>, read: bool| -> Option<(f64, f64)> {
-            if l.class != catalogue::LoopClass::StenmanValve {
-                return Some((f64::NAN, f64::NAN));
-            }
-            let mut s1 = with_process(l, &l.setup, f(l, &l.data)?);
-            let mut s0 = with_process(l, &twin, f(l, &twin_data)?);
-            if read {
-                s1.noise = stiction_core::detect::measurement_noise(&l.data.pv).max(1e-3);
-                s0.noise = stiction_core::detect::measurement_noise(&twin_data.pv).max(1e-3);
-            }
-            Some((
-                profile::profiled_band_free_llr(&s1, &run, &profile::WIDE),
-                profile::profiled_band_free_llr(&s0, &twin_run, &profile::WIDE),
-            ))
-        };
+    let free = |(p1, p0): (Foptd, Foptd), read: bool| -> Option<(f64, f64)> {
+        if l.class != catalogue::LoopClass::StenmanValve {
+            return Some((f64::NAN, f64::NAN));
+        }
+        let mut s1 = with_process(l, &l.setup, p1);
+        let mut s0 = with_process(l, &twin, p0);
+        if read {
+            s1.noise = stiction_core::detect::measurement_noise(&l.data.pv).max(1e-3);
+            s0.noise = stiction_core::detect::measurement_noise(&twin_data.pv).max(1e-3);
+        }
+        Some((
+            profile::profiled_band_free_llr(&s1, &run, &profile::WIDE),
+            profile::profiled_band_free_llr(&s0, &twin_run, &profile::WIDE),
+        ))
+    };
     Some([
         truth,
-        under(by_fit)?,
-        under(by_setpoint)?,
+        under(fit)?,
+        under(setpoint)?,
         each,
-        centred(by_fit)?,
-        centred(by_setpoint)?,
-        free(by_fit, false)?,
-        free(by_setpoint, false)?,
-        free(by_setpoint, true)?,
+        centred(fit)?,
+        centred(setpoint)?,
+        free(fit, false)?,
+        free(setpoint, false)?,
+        free(setpoint, true)?,
     ])
 }
 
@@ -271,15 +277,21 @@ fn main() {
         .collect();
     let rows: Vec<Row> = loops
         .par_iter()
-        .map(|l| Row {
-            class: l.class.to_string(),
-            kind: format!("{:?}", l.kind),
-            ts: l.setup.ts,
-            integrating: l.integrating,
-            truth: truth(l),
-            fit: by_fit(l, &l.data),
-            setpoint: by_setpoint(l, &l.data),
-            oracle: oracle(l),
+        .map(|l| {
+            let ids = Ids {
+                fit: by_fit(l, &l.data),
+                setpoint: by_setpoint(l, &l.data),
+            };
+            Row {
+                class: l.class.to_string(),
+                kind: format!("{:?}", l.kind),
+                ts: l.setup.ts,
+                integrating: l.integrating,
+                truth: truth(l),
+                fit: ids.fit,
+                setpoint: ids.setpoint,
+                oracle: oracle(l, ids),
+            }
         })
         .collect();
     let mut md = process_table(&rows, set);

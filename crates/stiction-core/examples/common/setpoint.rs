@@ -52,13 +52,13 @@ fn solve(a: &mut [f64], b: &mut [f64], n: usize) -> Option<()> {
 }
 
 /// Least squares of `y` on the columns `x` (each of `y`'s length), a little ridge for safety.
-pub fn least_squares(x: &[Vec<f64>], y: &[f64]) -> Option<Vec<f64>> {
+pub fn least_squares(x: &[&[f64]], y: &[f64]) -> Option<Vec<f64>> {
     let p = x.len();
     let mut a = vec![0.0; p * p];
     let mut b = vec![0.0; p];
     for i in 0..p {
         for j in 0..=i {
-            let s: f64 = x[i].iter().zip(&x[j]).map(|(u, v)| u * v).sum();
+            let s: f64 = x[i].iter().zip(x[j]).map(|(u, v)| u * v).sum();
             a[i * p + j] = s;
             a[j * p + i] = s;
         }
@@ -104,14 +104,13 @@ pub fn op_from_setpoint(sp: &[f64], op: &[f64], m: usize) -> Option<Vec<f64>> {
     let keep: Vec<usize> = (0..x.len())
         .filter(|&i| x[i].iter().any(|v| v.abs() > 1e-12))
         .collect();
-    let cols: Vec<Vec<f64>> = keep.iter().map(|&i| x[i].clone()).collect();
+    let cols: Vec<&[f64]> = keep.iter().map(|&i| x[i].as_slice()).collect();
     let beta = least_squares(&cols, op)?;
     let mut fitted = vec![0.0; n];
-    for (c, (&i, b)) in keep.iter().zip(&beta).enumerate() {
+    for (&i, b) in keep.iter().zip(&beta) {
         if i == 1 {
             continue;
         }
-        let _ = c;
         for (f, v) in fitted.iter_mut().zip(&x[i]) {
             *f += b * v;
         }
@@ -150,7 +149,7 @@ pub fn process_from(u: &[f64], pv: &[f64], ts: f64, integrating: bool) -> Option
                 };
                 y[t] = s;
             }
-            let cols = vec![ones.clone(), slope.clone(), y];
+            let cols = [ones.as_slice(), slope.as_slice(), y.as_slice()];
             let Some(beta) = least_squares(&cols, pv) else {
                 continue;
             };
