@@ -57,6 +57,9 @@ pub const REGULARITY_CAP: f64 = 1e6;
 /// Zero crossings of the autocorrelation used for the periods (about five periods).
 pub const MAX_CROSSINGS: usize = 11;
 
+/// The shortest period a sampled cycle can have, samples (the Nyquist limit).
+pub const MIN_PERIOD_SAMPLES: f64 = 2.0;
+
 /// The standard deviation of white measurement noise on `x`, robustly: the smaller of the
 /// estimates from first differences (MAD / 0.6745 / √2) and from second differences
 /// (MAD / 0.6745 / √6). Differences take slow variations off; first differences overstate the
@@ -175,7 +178,12 @@ fn regularity_from(mut crossings: Vec<f64>, ts: f64) -> Regularity {
     crossings.truncate(MAX_CROSSINGS);
     // each pair of crossings two apart spans one period
     let periods: Vec<f64> = crossings.windows(3).map(|w| (w[2] - w[0]) * ts).collect();
-    let (period, r) = if periods.is_empty() {
+    let mean_samples = periods.iter().sum::<f64>() / (periods.len().max(1) as f64 * ts);
+    // a sampled cycle spans at least two samples (a faster one aliases to a slower one): a
+    // "period" under two samples is the autocorrelation of noise changing sign from one lag to
+    // the next (a held OP, PV's differences), no oscillation (on the catalogue's routine windows
+    // of 1 s such records reported cycles of 1.2 to 1.9 s, "perfectly regular")
+    let (period, r) = if periods.is_empty() || mean_samples < MIN_PERIOD_SAMPLES {
         (None, 0.0)
     } else {
         let m = periods.iter().sum::<f64>() / periods.len() as f64;
@@ -538,6 +546,32 @@ mod tests {
         let r = regularity(&sine(2000, 50.0, 1.0, 0.3), 1.0);
         assert!(r.oscillating, "{r:?}");
         assert!((r.period.unwrap() - 50.0).abs() < 2.0, "{r:?}");
+    }
+
+    /// Law (Nyquist): no sampled cycle is shorter than two samples, so an autocorrelation that
+    /// changes sign from lag to lag is no oscillation, however evenly it does.
+    #[test]
+    fn an_autocorrelation_that_flips_sign_every_lag_is_no_cycle() {
+        // a sign change in every lag interval, each 0.1 of a lag earlier than the one before
+        // (crossings at 0.9, 1.8, 2.7, 3.6, 4.5): "periods" of 1.8 samples, all alike
+        let mut acf = vec![1.0];
+        for f in [0.9, 0.8, 0.7, 0.6, 0.5] {
+            let a: f64 = *acf.last().unwrap();
+            acf.push(a * (f - 1.0) / f);
+        }
+        let tail = acf[acf.len() - 1];
+        acf.extend(std::iter::repeat_n(tail, 30));
+        for ts in [1.0, 10.0] {
+            let r = regularity_of(&acf, ts);
+            assert_eq!(r.zero_crossings, 5, "{r:?}");
+            assert_eq!(r.period, None, "{r:?}");
+            assert_eq!(r.regularity, 0.0, "{r:?}");
+            assert!(!r.oscillating, "{r:?}");
+        }
+        // a cycle of three samples is one
+        let r = regularity(&sine(600, 3.0, 1.0, 0.05), 1.0);
+        assert!(r.oscillating, "{r:?}");
+        assert!((r.period.unwrap() - 3.0).abs() < 0.2, "{r:?}");
     }
 
     #[test]
