@@ -184,7 +184,7 @@ fn record(d: &Diagnosis) {
     );
     if let Some(o) = &d.oscillation {
         println!(
-            "  oscillation: {}{}; period {}; regularity {:.2} (threshold {}); {} half periods with a large IAE",
+            "  oscillation: {}{}; period {}; regularity {} (threshold {}); {} half periods with a large IAE",
             match (o.oscillating, o.across_setpoint_steps, o.weak_cycle) {
                 (true, true, false) =>
                     "yes, across the setpoint's steps (its holds are too short)".to_string(),
@@ -197,7 +197,7 @@ fn record(d: &Diagnosis) {
             },
             o.reading_words().map_or(String::new(), |w| format!(" ({w})")),
             o.period.map_or("-".into(), |p| format!("{p:.1} s")),
-            o.regularity.regularity,
+            o.regularity.shown(),
             o.regularity.threshold,
             o.iae.exceedances
         );

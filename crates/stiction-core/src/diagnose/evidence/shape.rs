@@ -43,8 +43,8 @@ impl EvidenceFamily for Shape {
             let _ = ctx.indices.set(Vec::new());
             let why = if !osc.oscillating {
                 format!(
-                    "no oscillation above the noise on the longest constant-setpoint stretch (regularity {:.2}, amplitude {:.3} vs noise {:.3})",
-                    osc.regularity.regularity, osc.amplitude, osc.noise_std
+                    "no oscillation above the noise on the longest constant-setpoint stretch (regularity {}, amplitude {:.3} vs noise {:.3})",
+                    osc.regularity.shown(), osc.amplitude, osc.noise_std
                 )
             } else {
                 format!(
@@ -115,9 +115,9 @@ impl EvidenceFamily for Shape {
             statistic: statistic.into(),
             threshold,
             note: format!(
-                "oscillation of period {:.1} s, regularity {:.2}: {note}{}",
+                "oscillation of period {:.1} s, regularity {}: {note}{}",
                 osc.period.unwrap_or(0.0),
-                osc.regularity.regularity,
+                osc.regularity.shown(),
                 if drawn {
                     format!(
                         "; but PV repeats itself or runs in exactly straight lines in {:.0} % of the oscillating stretch (historian compression): \
