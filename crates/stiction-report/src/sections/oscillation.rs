@@ -40,7 +40,7 @@ pub fn oscillation(d: &Diagnosis) -> Option<Vec<KvRow>> {
             "Regularity (Thornhill)",
             format!(
                 "{} (regular above {}; {} zero crossings of the autocorrelation)",
-                num(r.regularity),
+                r.shown(),
                 num(r.threshold),
                 r.zero_crossings
             ),
