@@ -50,10 +50,11 @@ pub struct Regularity {
 
 impl Regularity {
     /// The regularity as an engineer reads it: its value, or what stands in for one that does not
-    /// measure a spread (a single period, or periods alike to the last digit).
+    /// measure a spread (an autocorrelation that shows a single period, or periods alike to the last
+    /// digit).
     pub fn shown(&self) -> String {
         if self.period.is_some() && self.zero_crossings < 5 {
-            "not measured (one period)".into()
+            "not measured: the autocorrelation shows one period".into()
         } else if self.regularity >= REGULARITY_CAP {
             "perfectly regular".into()
         } else {
@@ -591,7 +592,10 @@ mod tests {
     #[test]
     fn a_regularity_without_a_spread_is_shown_in_words() {
         let at = |crossings: Vec<f64>| regularity_from(crossings, 1.0).shown();
-        assert_eq!(at(vec![2.0, 7.0, 12.0]), "not measured (one period)");
+        assert_eq!(
+            at(vec![2.0, 7.0, 12.0]),
+            "not measured: the autocorrelation shows one period"
+        );
         assert_eq!(at(vec![2.0, 7.0, 12.0, 17.0, 22.0]), "perfectly regular");
         assert_eq!(at(vec![2.0, 7.0, 12.0, 18.0, 22.0]), "7.31");
         assert_eq!(at(Vec::new()), "0.00");
