@@ -53,8 +53,8 @@ impl Regularity {
     /// measure a spread (an autocorrelation that shows a single period, or periods alike to the last
     /// digit).
     pub fn shown(&self) -> String {
-        if self.period.is_some() && self.zero_crossings < 5 {
-            "not measured: the autocorrelation shows one period".into()
+        if self.period.is_some() && self.zero_crossings < SPREAD_CROSSINGS {
+            "not measured: the autocorrelation shows under two periods".into()
         } else if self.regularity >= REGULARITY_CAP {
             "perfectly regular".into()
         } else {
@@ -74,6 +74,10 @@ pub const MAX_CROSSINGS: usize = 11;
 
 /// The shortest period a sampled cycle can have, samples (the Nyquist limit).
 pub const MIN_PERIOD_SAMPLES: f64 = 2.0;
+
+/// Zero crossings of the autocorrelation that span two periods: a regularity from fewer
+/// measures no spread of the periods.
+pub const SPREAD_CROSSINGS: usize = 5;
 
 /// The standard deviation of white measurement noise on `x`, robustly: the smaller of the
 /// estimates from first differences (MAD / 0.6745 / √2) and from second differences
@@ -193,15 +197,14 @@ fn regularity_from(mut crossings: Vec<f64>, ts: f64) -> Regularity {
     crossings.truncate(MAX_CROSSINGS);
     // each pair of crossings two apart spans one period
     let periods: Vec<f64> = crossings.windows(3).map(|w| (w[2] - w[0]) * ts).collect();
-    let mean_samples = periods.iter().sum::<f64>() / (periods.len().max(1) as f64 * ts);
+    let m = periods.iter().sum::<f64>() / periods.len().max(1) as f64;
     // a sampled cycle spans at least two samples (a faster one aliases to a slower one): a
     // "period" under two samples is the autocorrelation of noise changing sign from one lag to
     // the next (a held OP, PV's differences), no oscillation (on the catalogue's routine windows
     // of 1 s such records reported cycles of 1.2 to 1.9 s, "perfectly regular")
-    let (period, r) = if periods.is_empty() || mean_samples < MIN_PERIOD_SAMPLES {
+    let (period, r) = if periods.is_empty() || m < MIN_PERIOD_SAMPLES * ts {
         (None, 0.0)
     } else {
-        let m = periods.iter().sum::<f64>() / periods.len() as f64;
         let sd =
             (periods.iter().map(|p| (p - m) * (p - m)).sum::<f64>() / periods.len() as f64).sqrt();
         // capped: perfectly regular periods would give infinity, which JSON cannot carry
@@ -594,7 +597,7 @@ mod tests {
         let at = |crossings: Vec<f64>| regularity_from(crossings, 1.0).shown();
         assert_eq!(
             at(vec![2.0, 7.0, 12.0]),
-            "not measured: the autocorrelation shows one period"
+            "not measured: the autocorrelation shows under two periods"
         );
         assert_eq!(at(vec![2.0, 7.0, 12.0, 17.0, 22.0]), "perfectly regular");
         assert_eq!(at(vec![2.0, 7.0, 12.0, 18.0, 22.0]), "7.31");
