@@ -2,6 +2,7 @@
 
 use super::*;
 use stiction_core::diagnose::evidence::hidden_valve::THRESHOLD;
+use stiction_core::diagnose::evidence::HiddenValveEvidence;
 
 #[test]
 fn thorough_finds_a_valve_the_fit_of_changes_misses_and_reports_its_band() {
@@ -84,12 +85,7 @@ fn a_hidden_valve_ratio_under_the_threshold_is_drawn_once() {
     // fast-b-0135 of the catalogue's benchmark set: a healthy valve under an external
     // oscillation. The hidden valve judges it, finds no sticky valve worth a vote, and does not
     // draw the particle filter's noise again
-    let d = thorough_diagnosis("fast-b-0135");
-    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
-    let hidden = hidden_valve_of(&d);
-    assert_eq!(hidden.vote, Vote::Undetermined, "{}", hidden.note);
-    let h = hidden.hidden_valve.as_ref().unwrap();
-    assert!(h.ratio < THRESHOLD, "{h:?}");
+    let h = judged_under_the_threshold("fast-b-0135");
     assert_eq!(h.draws, vec![h.ratio], "{h:?}");
 }
 
@@ -123,12 +119,19 @@ fn the_hidden_valves_healthy_loop_carries_the_cycle_the_loop_shows() {
     // so a cycling load placed there left the sine to the sticky hypothesis, which took it at a
     // ratio of 185. Offered the period of the oscillation the loop shows too, the healthy loop
     // takes it there, explains the sine, and no hidden valve does better.
-    let d = thorough_diagnosis("routine-b-0472");
+    judged_under_the_threshold("routine-b-0472");
+}
+
+/// The catalogue loop `id` diagnosed with `thorough`: not called sticky, the hidden valve judged
+/// it and found a ratio under the threshold (no vote). Its evidence.
+fn judged_under_the_threshold(id: &str) -> HiddenValveEvidence {
+    let d = thorough_diagnosis(id);
     assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
     let hidden = hidden_valve_of(&d);
     assert_eq!(hidden.vote, Vote::Undetermined, "{}", hidden.note);
-    let h = hidden.hidden_valve.as_ref().unwrap();
+    let h = hidden.hidden_valve.clone().unwrap();
     assert!(h.ratio < THRESHOLD, "{h:?}");
+    h
 }
 
 /// The catalogue loop `id` diagnosed with `thorough`, as the CLI judges it.
