@@ -53,7 +53,7 @@ use stiction_core::models::{He, Kano, Model, Stenman};
 use stiction_core::sim::catalogue::{self, BenchmarkLoop, LoopClass, LoopKind, Suite, Truth};
 use study_args::StudyArgs;
 use unknown::{less_known, Unknown};
-use unknown_tables::{by_kind_table, unknown_table};
+use unknown_tables::{by_kind_table, ranking_table, unknown_table};
 
 /// A sticky valve from the suite's ranges, for a healthy loop's sticky hypothesis.
 fn drawn_valve(seed: u64) -> Model {
@@ -254,6 +254,7 @@ fn main() {
     }
     if bands > 0 {
         unknown_table(&mut md, &rows, bands);
+        ranking_table(&mut md, &rows);
         by_kind_table(&mut md, &rows);
     }
     if particles > 0 {
