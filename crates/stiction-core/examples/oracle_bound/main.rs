@@ -33,6 +33,10 @@
 //! that do not know the band. Beside them, the oracles that know less (the table's text says
 //! each): the process identified, profiled or searched under each hypothesis, or a fixed amount
 //! wrong; OP too seen only at the recorded samples (held, or a straight line between them).
+//! The rows that maximise a band (and the process) under the sticky hypothesis are no calibrated
+//! test at ratio 1, so they are also read at every threshold: the area under the ROC curve and
+//! the balanced accuracy at the threshold that does best on the pairs themselves (an upper bound
+//! for that ratio under any threshold set elsewhere).
 //!
 //! `--particles N` adds, for the Stenman loops of 10 s, the hidden-valve oracle: a particle
 //! filter of N particles over the whole loop between the records (`particles.rs`, `hidden.rs`).
