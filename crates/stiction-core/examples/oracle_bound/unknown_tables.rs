@@ -318,7 +318,7 @@ pub fn ranking_table(md: &mut String, rows: &[Row]) {
 
 /// The chance that a sticky loop's ratio exceeds a twin's (ties count half), over every sticky
 /// loop and every twin.
-fn area_under_roc(pairs: &[(f64, f64)]) -> f64 {
+pub fn area_under_roc(pairs: &[(f64, f64)]) -> f64 {
     let mut wins = 0.0;
     for &(s, _) in pairs {
         for &(_, t) in pairs {
@@ -335,7 +335,7 @@ fn area_under_roc(pairs: &[(f64, f64)]) -> f64 {
 }
 
 /// The best balanced accuracy of "sticky where the ratio exceeds c" over every threshold c.
-fn best_balanced(pairs: &[(f64, f64)]) -> f64 {
+pub fn best_balanced(pairs: &[(f64, f64)]) -> f64 {
     let n = pairs.len().max(1) as f64;
     let mut cuts: Vec<f64> = pairs.iter().flat_map(|&(s, t)| [s, t]).collect();
     cuts.push(f64::NEG_INFINITY);
