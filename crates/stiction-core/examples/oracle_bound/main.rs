@@ -280,10 +280,10 @@ fn main() {
     if bands > 0 {
         unknown_table(&mut md, &rows, bands);
         ranking_table(&mut md, &rows);
+        by_kind_table(&mut md, &rows);
         if swept {
             sweep::sweep_table(&mut md, &rows, bands);
         }
-        by_kind_table(&mut md, &rows);
     }
     if particles > 0 {
         hidden::hidden_table(&mut md, &rows, particles);
