@@ -120,7 +120,7 @@ fn judge(l: &BenchmarkLoop, bands: usize, particles: usize, swept: bool) -> Row 
     let twin = llrs(&twin_setup, &l.setup.model, &twin_run);
     let unknown = (bands > 0 && l.class == LoopClass::StenmanValve)
         .then(|| less_known(l, &twin_setup, &run, &twin_run, bands));
-    let sweep = (swept && bands > 0 && l.class == LoopClass::StenmanValve).then(|| {
+    let sweep = (swept && l.class == LoopClass::StenmanValve).then(|| {
         sweep::sweep(
             &l.setup,
             &l.setup.model,

@@ -5,8 +5,8 @@
 use super::kalman::{llrs, FullRun};
 use super::profile::rescaled;
 use super::unknown::band_unknown;
-use super::unknown_tables::{area_under_roc, best_balanced};
-use super::{balanced, share, Row};
+use super::unknown_tables::{area_under_roc, best_balanced, shares};
+use super::{balanced, Row};
 use std::fmt::Write as _;
 use stiction_core::models::Model;
 use stiction_core::sim::ClosedLoop;
@@ -74,10 +74,8 @@ pub fn sweep_table(md: &mut String, rows: &[Row], bands: usize) {
         let known: Vec<(f64, f64)> = swept.iter().map(|s| s[i][0]).collect();
         let unknown: Vec<(f64, f64)> = swept.iter().map(|s| s[i][1]).collect();
         let ba = |p: &[(f64, f64)]| {
-            balanced(
-                share(p.iter().map(|x| x.0 > 0.0)),
-                share(p.iter().map(|x| x.1 <= 0.0)),
-            )
+            let (hit, twin) = shares(p);
+            balanced(hit, twin)
         };
         let words = format!(
             "gain {:+.0} %, time constant and dead time {:+.0} %",

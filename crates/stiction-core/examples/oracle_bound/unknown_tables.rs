@@ -209,7 +209,7 @@ pub fn by_kind_table(md: &mut String, rows: &[Row]) {
 }
 
 /// The shares of sticky loops called sticky (ratio above 0) and of twins called healthy.
-fn shares(p: &[(f64, f64)]) -> ((usize, usize), (usize, usize)) {
+pub fn shares(p: &[(f64, f64)]) -> ((usize, usize), (usize, usize)) {
     (
         share(p.iter().map(|u| u.0 > 0.0)),
         share(p.iter().map(|u| u.1 <= 0.0)),
