@@ -1,6 +1,6 @@
-//! Diagnosis benchmarks. Run: cargo bench -p stiction-core --bench diagnose
-#[path = "../examples/common/catalogue_loop.rs"]
-mod catalogue_loop;
+//! Diagnosis benchmarks on loops of the public simulation. Run: cargo bench -p stiction-core --bench
+//! diagnose (the catalogue's hidden-valve loop: `cargo bench -p stiction-lab --bench
+//! diagnose_catalogue`).
 
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion};
@@ -97,30 +97,6 @@ fn benches(c: &mut Criterion) {
         &[
             ("fast_sticky_2000".into(), fast(true)),
             ("fast_sticky_2000_without_quantify".into(), fast(false)),
-        ],
-    );
-    // --thorough where the hidden-valve family runs: a fast loop of the catalogue's calibration
-    // set whose valve slips between the samples (fast-c-0007; the families without it call it
-    // no_stiction), beside the same loop judged by default
-    let l = stiction_core::sim::catalogue::find("fast-c-0007").unwrap();
-    let rec = catalogue_loop::record(&l);
-    let catalogue = |thorough| DiagnoseRequest {
-        quantify: false,
-        thorough,
-        ..catalogue_loop::request(&l)
-    };
-    bench_each(
-        &mut g,
-        &rec,
-        &[
-            (
-                "hidden_valve_2000_without_quantify".into(),
-                catalogue(false),
-            ),
-            (
-                "hidden_valve_2000_thorough_without_quantify".into(),
-                catalogue(true),
-            ),
         ],
     );
     g.finish();

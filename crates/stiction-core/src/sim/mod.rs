@@ -2,8 +2,7 @@
 //! with a sticky valve, a process (first order, integrating or two lags, with dead time) and
 //! measurement noise; around it the plant features routine historian data show (a controller
 //! faster than the historian, actuator lag, installed characteristic, load and output
-//! disturbances, quantisation, historian compression, a cascade), and the catalogue of benchmark
-//! loops built from them ([`catalogue`]).
+//! disturbances, quantisation, historian compression, a cascade).
 
 mod closed_loop;
 mod historian;
@@ -11,8 +10,6 @@ mod process;
 mod signal;
 mod stepping;
 mod valve;
-
-pub mod catalogue;
 
 pub use closed_loop::{Cascade, ClosedLoop, LoopRun, Pi};
 pub use historian::{

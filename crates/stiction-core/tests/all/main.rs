@@ -2,7 +2,6 @@
 //! One binary links once, where a binary per file linked the crate and proptest eight times.
 //! Run one part with a filter: `cargo test -p stiction-core --test all plant_sim`.
 
-mod catalogue;
 mod diagnose;
 mod estimation;
 mod limit_cycle;
