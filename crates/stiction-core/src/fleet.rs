@@ -220,7 +220,7 @@ pub const REGULAR: f64 = 1.0;
 /// For each row, how many other rows oscillate at its period ([`SAME_PERIOD`]; both regular,
 /// [`REGULAR`]); 0 for a row that does not oscillate. Where several loops of one unit share a
 /// period, one of them may drive the others: a stiction verdict on a loop that shares its period
-/// is read with that in mind (docs/propagated-oscillation.md). Loops from different units or
+/// is read with that in mind (stiction-lab/results/propagated-oscillation.md). Loops from different units or
 /// time windows can share a period by chance.
 pub fn same_period<'a>(rows: impl IntoIterator<Item = &'a Row>) -> Vec<usize> {
     let periods: Vec<Option<f64>> = rows

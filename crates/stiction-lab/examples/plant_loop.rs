@@ -1,7 +1,7 @@
 //! Write one loop of the benchmark catalogue (`stiction_lab::catalogue`) as a CSV file with
 //! the columns `t,sp,op,mv,pv`, so it can be given to `stiction diagnose`.
 //!
-//!     cargo run --release -p stiction-core --example plant_loop -- ID FILE
+//!     cargo run --release -p stiction-lab --example plant_loop -- ID FILE
 //!
 //! ID is a catalogue id: `routine-b-0042` (routine suite, benchmark set, loop 42), `fast-c-0007`
 //! (fast suite, calibration set), or `issue14`. The loop's description and the matching

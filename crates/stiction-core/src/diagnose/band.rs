@@ -38,7 +38,7 @@ const CROSS_CHECK: f64 = 1.5;
 
 /// The closed-loop fit also fits Kano's valve, its slip jump `J` free beside the band `S`. A
 /// Stenman fit, bound to jump all the way back to OP, often settles on a small band near OP
-/// (docs/sampled-valve.md: the knife-edge partition, a controller moving OP between samples); the
+/// (stiction-lab/results/sampled-valve.md: the knife-edge partition, a controller moving OP between samples); the
 /// slip-jump valve's `S` less so. Where the describing function has not replaced the Stenman band
 /// and `S` is larger than it by more than this factor, `S` is reported, the Stenman band beside
 /// it. Measured on the catalogue's calibration draws (`plant_benchmark --extra`, the calibration
@@ -63,7 +63,7 @@ const UNRESOLVED_NOISES: f64 = 2.0;
 /// Where the levels test (`thorough`) voted stiction, its band and the closed-loop estimate's are
 /// two estimates; when they differ by more than this factor the levels test's is reported. The
 /// fit of PV's changes often settles on a small band near OP where the levels test finds the
-/// valve (docs/sampled-valve.md). Measured with `plant_benchmark --thorough --jsonl` on the sticky
+/// valve (stiction-lab/results/sampled-valve.md). Measured with `plant_benchmark --thorough --jsonl` on the sticky
 /// loops called `stiction` whose levels ratio reached the threshold (band within 1.5x of the
 /// simulated band): the verdict's band before the rule in 58 of 92 (calibration set) and 65 of 93
 /// (benchmark set), the levels test's in 56 and 63, this rule's in 61 and 70.

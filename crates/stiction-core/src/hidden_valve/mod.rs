@@ -2,7 +2,7 @@
 //!
 //! Where the controller moves OP between the recorded samples, no valve model run on the recorded
 //! OP reproduces a sticky valve: noise the record does not hold decides the sample at which it
-//! slips (`docs/sampled-valve.md`). The closed-loop fits then see no band, yet PV shows every
+//! slips (`stiction-lab/results/sampled-valve.md`). The closed-loop fits then see no band, yet PV shows every
 //! slip. Here the valve's position is hidden: a particle filter carries many positions, each
 //! slipping when OP, as the controller may have moved it between the samples, leaves the band,
 //! and each with the loop's state filtered exactly (the loop is linear and Gaussian given the
@@ -15,8 +15,8 @@
 //! searched again from the sticky one's optimum, so the ratio is never an artefact of a search
 //! that stopped short.
 //!
-//! The study (`examples/hidden_valve`; `docs/hidden-valve-fast.md` and
-//! `docs/hidden-valve-routine.md`) set where it holds; `diagnose --thorough` runs it there as the
+//! The study (`stiction-lab/examples/hidden_valve`; `stiction-lab/results/hidden-valve-fast.md` and
+//! `stiction-lab/results/hidden-valve-routine.md`) set where it holds; `diagnose --thorough` runs it there as the
 //! hidden-valve family ([`crate::diagnose::evidence::hidden_valve`]).
 
 mod ascent;

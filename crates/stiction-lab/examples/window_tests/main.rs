@@ -3,8 +3,8 @@
 //! valves than we did, though with many false alarms on healthy loops; we must find what they
 //! find without their false alarms").
 //!
-//!     cargo run --release -p stiction-core --example window_tests -- [--set routine|fast|all]
-//!         [--draws N] [--out docs/window-tests.md]
+//!     cargo run --release -p stiction-lab --example window_tests -- [--set routine|fast|all]
+//!         [--draws N] [--out crates/stiction-lab/results/window-tests.md]
 //!
 //! Each baseline (`baselines.rs`) gives a count per record and flags it sticky either from a
 //! count of one (the naive reading: any window fires) or from a rate (the share of windows that

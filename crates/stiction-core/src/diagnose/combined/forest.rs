@@ -1,4 +1,4 @@
-//! Gradient-boosted trees, as `scripts/train_combined.py` writes them (`forest.json`): each node
+//! Gradient-boosted trees, as `stiction-lab/scripts/train_combined.py` writes them (`forest.json`): each node
 //! `[feature, threshold, left, right, value]`, a leaf where `left` is 0 (the root is node 0, so
 //! no child is). A sample goes left where its statistic is at or below the threshold. Every node
 //! carries the mean of the leaves under it (weighted by the training samples that reached them),

@@ -10,7 +10,7 @@
 //! few look-alikes: out of fold on their training loops, under one healthy loop in 200.
 //! They never take one away, never decide where the valve position is recorded, and never
 //! decide against stiction: a learned combination does not hold where the catalogue does not
-//! teach it (docs/accuracy-history.md, "A learned combination of the families' statistics": as
+//! teach it (stiction-lab/journal/accuracy-history.md, "A learned combination of the families' statistics": as
 //! the whole verdict it lost ISDB loops whose statistics the catalogue has no example of), so
 //! its low probabilities are no evidence. Where it decides, the verdict names the statistics that
 //! weighed most.

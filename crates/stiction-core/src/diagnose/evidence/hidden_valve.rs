@@ -3,7 +3,7 @@
 //!
 //! Where the controller moves OP between the recorded samples, the valve slips at instants the
 //! record does not hold, so no valve model run on the recorded OP reproduces it and the fits with
-//! and without a band look alike (docs/sampled-valve.md); a particle filter over the valve's
+//! and without a band look alike (stiction-lab/results/sampled-valve.md); a particle filter over the valve's
 //! position sees every slip in PV. It costs seconds a loop (a few hundred particle filters), so it
 //! runs only with `thorough`, only where the other families have not already decided `stiction`,
 //! and only where it was calibrated: an oscillating loop, PV recorded (not compressed, not
@@ -35,7 +35,7 @@ pub struct HiddenValve;
 /// rule gives 75 (2026-11-29). Since the cycling load may sit at the period of the cycle the
 /// loop shows, the fast loops' highest is 70.4 (an external oscillation), the routine windows' still
 /// 74.1, so 75 stands. The benchmark sets were judged at it after
-/// (docs/plant-benchmark-thorough.md, docs/accuracy-history.md).
+/// (stiction-lab/results/plant-benchmark-thorough.md, stiction-lab/journal/accuracy-history.md).
 pub const THRESHOLD: f64 = 75.0;
 /// OP's travel (5th to 95th percentile, twice its amplitude) above this share of the valve span
 /// leaves the family silent: on the routine calibration windows an equal-percentage valve under a
@@ -44,7 +44,7 @@ pub const THRESHOLD: f64 = 75.0;
 pub const MAX_OP_TRAVEL: f64 = 0.10;
 /// PV samples not recorded (runs of repeats or exactly straight lines) above this share leave the
 /// family silent: a held or straight-lined PV is no Gaussian measurement, and compressed records
-/// reach ratios in the thousands (docs/hidden-valve-routine.md).
+/// reach ratios in the thousands (stiction-lab/results/hidden-valve-routine.md).
 pub const MAX_UNRECORDED: f64 = 0.05;
 /// Particles of the sticky hypothesis's filter (the calibrated setting). 100 before: on the fast
 /// calibration and benchmark sets' 113 loops the family judges, 50 call the same sticky loops

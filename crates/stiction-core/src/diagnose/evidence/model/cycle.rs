@@ -18,7 +18,7 @@
 //! benchmark's), 341 of them with test ratios under 50 (the highest 48), where the sticky loops
 //! that reach it give up to 1,238; over all ten calibration draws one healthy loop more votes
 //! (a narrow-band load at the loop's period, regularity 1.5, ratio 71). What each step of it
-//! moved, on the calibration draws and then the benchmark, is in `docs/accuracy-history.md`: it
+//! moved, on the calibration draws and then the benchmark, is in `stiction-lab/journal/accuracy-history.md`: it
 //! first ran only on limit cycles whose fits looked alike and voted from a ratio of 100.
 
 use super::{Levels, MIN_EXPLAINED, SIGNIFICANCE_NONE, SIGNIFICANCE_STICTION};

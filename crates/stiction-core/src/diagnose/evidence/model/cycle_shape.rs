@@ -19,7 +19,7 @@
 //! cycle's timing with a shape PV does not have. Measured on the batch benchmark's mix (outside
 //! the catalogue: a sine of period 100-250 s added to PV, the setpoint constant; 250 loops), 9
 //! of its 19 loops called `stiction` are no longer, and on the catalogue's 18 sets, the ISDB and
-//! the 108 loops no verdict moves (docs/accuracy-history.md).
+//! the 108 loops no verdict moves (stiction-lab/journal/accuracy-history.md).
 
 use super::{Context, LIMIT_CYCLE_REGULARITY};
 use crate::diagnose::evidence::limit_cycle::{measurable_harmonics, MIN_HARMONICS};

@@ -4,7 +4,7 @@
 //!
 //! Why a second test: the closed-loop fit compares PV's changes over a lag with PV's own past
 //! among its regressors, and on records sampled at every controller execution that criterion
-//! often ranks the true band's valve below a small band near OP (docs/sampled-valve.md: on the
+//! often ranks the true band's valve below a small band near OP (stiction-lab/results/sampled-valve.md: on the
 //! routine 1 s records it prefers the true band's valve in 10 of 40 Stenman loops; the levels
 //! test in 36). The levels test has no PV past among its regressors and cannot be biased towards
 //! OP by the controller's feedback of PV's noise.
@@ -22,7 +22,7 @@
 //! cannot. On the catalogue's routine windows with load steps the test's best valve was such a
 //! band (0.04-0.07 % of span, over OP's noise of 0.01-0.02 %) at ratios of 64 to 146, and one of
 //! them was called `stiction` for it; the sticky valves' bands it found were 0.2 % and more
-//! (`docs/accuracy-history.md`, 2026-11-29 evening).
+//! (`stiction-lab/journal/accuracy-history.md`, 2026-11-29 evening).
 
 use super::super::valve::MIN_BAND_PERCENT;
 use super::super::Context;

@@ -59,7 +59,7 @@ pub struct Model;
 /// nine more draws, 2,078 not-sticky routine loops, the 95th percentile is 55 and 5.6 % reach
 /// 50. Before the fits' delays stopped short of the lag: 42 and 55, and 51 and 5.2 %). Since the
 /// look-alikes with load steps and with a fed-forward load joined the calibration set (264
-/// not-sticky routine loops; `docs/calibration.md`, 2026-11-27) the 95th and 97.5th percentiles
+/// not-sticky routine loops; `stiction-lab/results/calibration.md`, 2026-11-27) the 95th and 97.5th percentiles
 /// are 55 and 129 and 6 % reach 50: those look-alikes' high ratios are a fit that mirrors the
 /// controller or follows OP's unprovoked steps, and such votes are withdrawn (`withdraw.rs`).
 pub const SIGNIFICANCE_STICTION: f64 = 50.0;

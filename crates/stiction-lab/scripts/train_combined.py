@@ -17,16 +17,16 @@ the ISDB:
     python3 -m venv $D/venv && $D/venv/bin/pip install numpy scikit-learn
     # only when the statistics changed (the embedded trees read another list, so the diagnoses
     # carry none): embed trees that read the new list and never decide, then build
-    $D/venv/bin/python scripts/train_combined.py --placeholder crates/stiction-core/src/diagnose/combined/forest.json
-    cargo build --release -p stiction-core --example plant_benchmark
+    $D/venv/bin/python crates/stiction-lab/scripts/train_combined.py --placeholder crates/stiction-core/src/diagnose/combined/forest.json
+    cargo build --release -p stiction-lab --example plant_benchmark
     B=target/release/examples/plant_benchmark
     for s in routine fast; do
       $B --set $s --calibration --out $D/x.md --jsonl $D/$s-c.jsonl
       for n in 1 2 3 $(seq 10 29); do $B --set $s --extra $n --out $D/x.md --jsonl $D/$s-x$n.jsonl; done
     done
-    cargo run --release -p stiction-core --example propagated_oscillation -- --extra $(seq -s, 10 29) \
+    cargo run --release -p stiction-lab --example propagated_oscillation -- --extra $(seq -s, 10 29) \
       --out $D/x.md --jsonl $D/propagated.jsonl
-    $D/venv/bin/python scripts/train_combined.py crates/stiction-core/src/diagnose/combined/forest.json $D/*.jsonl
+    $D/venv/bin/python crates/stiction-lab/scripts/train_combined.py crates/stiction-core/src/diagnose/combined/forest.json $D/*.jsonl
 
 The threshold: the lowest of 0.50, 0.55, ..., 0.95 at which, out of fold (five folds of the
 training loops, drawn at random with seed 0), the trees would turn at most 0.5 % of the look-alikes (healthy valves of every
@@ -161,7 +161,7 @@ def nodes(predictor):
     return out
 
 
-FEATURES = pathlib.Path(__file__).parent.parent / "crates/stiction-core/src/diagnose/combined/features.rs"
+FEATURES = pathlib.Path(__file__).resolve().parents[3] / "crates/stiction-core/src/diagnose/combined/features.rs"
 
 
 def placeholder(out):

@@ -8,10 +8,10 @@ fits, the stick-slip episodes, the shape indices, the loop family's lag, gain, d
 residual, the oscillation, the compression share), on further calibration draws of the
 catalogue, and judges them where the rules are judged: the catalogue's calibration and benchmark
 sets (other seeds), the ISDB's 14 loops and the 108-loop oscillating set. Results in
-docs/accuracy-history.md ("A learned combination of the families' statistics").
+crates/stiction-lab/journal/accuracy-history.md ("A learned combination of the families' statistics").
 
     D=/tmp/combination; mkdir -p $D
-    cargo build --release -p stiction-core --examples
+    cargo build --release -p stiction-lab --examples
     B=target/release/examples
     for s in routine fast; do
       for n in 1 2 3 4 5 6; do $B/plant_benchmark --set $s --extra $n --out $D/x.md --jsonl $D/$s-extra$n.jsonl; done
@@ -20,7 +20,7 @@ docs/accuracy-history.md ("A learned combination of the families' statistics").
     done
     $B/diagnose_benchmark --out $D/x.md --jsonl $D/diagnose.jsonl     # needs ../shared/data/isdb
     python3 -m venv $D/venv && $D/venv/bin/pip install numpy scikit-learn
-    $D/venv/bin/python scripts/combination_study.py $D
+    $D/venv/bin/python crates/stiction-lab/scripts/combination_study.py $D
 """
 
 import collections

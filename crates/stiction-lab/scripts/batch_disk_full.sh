@@ -5,7 +5,7 @@
 # file left behind, and after --resume the summary of an undisturbed run (timing aside).
 #
 # Opt-in, needs root (mount) and python3 (to compare the summaries):
-#     cargo build --release && sudo scripts/batch_disk_full.sh [LOOPS] [SIZE]
+#     cargo build --release && sudo crates/stiction-lab/scripts/batch_disk_full.sh [LOOPS] [SIZE]
 # LOOPS defaults to 168 (8 simulated loops copied 21 times), SIZE to 2m. STICTION names the
 # binary (default target/release/stiction).
 set -euo pipefail
