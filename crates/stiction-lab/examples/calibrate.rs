@@ -115,7 +115,7 @@ fn main() {
         .iter()
         .position(|a| a == "--out")
         .map(|i| args[i + 1].clone());
-    let threshold = stiction_core::diagnose::evidence::model::SIGNIFICANCE_STICTION;
+    let threshold = stiction_core::diagnose::Thresholds::default().significance_stiction;
     let mut md = String::new();
     let _ = writeln!(
         md,

@@ -11,6 +11,7 @@
 //! - `verdict`: families that agree decide, families that conflict give `undetermined`;
 //! - `band`: when the verdict is `stiction`, the band in % of valve span and where it comes from;
 //! - [`reach`]: the bands a record like this one shows and hides, from OP's noise;
+//! - [`Thresholds`]: the families' thresholds as one table, for studies and tests;
 //! - `windows`: the same judgement per window of the record.
 
 mod band;
@@ -25,6 +26,7 @@ mod result;
 mod saturation;
 pub mod setpoint;
 mod stretch;
+mod thresholds;
 mod verdict;
 mod windows;
 
@@ -35,6 +37,7 @@ pub use request::{DiagnoseError, DiagnoseRequest};
 pub use result::{
     Band, BandSource, Diagnosis, Index, Oscillation, SetpointReadOff, Verdict, Vote, WindowVerdict,
 };
+pub use thresholds::Thresholds;
 
 /// The signals of one loop record (op, pv, and when recorded sp, mv, time in seconds, and
 /// `auto`: `true` where the controller is in automatic). Missing values are NaN.

@@ -26,7 +26,7 @@ mod model;
 mod search;
 
 pub use likelihood::{healthy_log_likelihood, sticky_log_likelihood, Particles, Record, Slip};
-pub use model::{LoopModel, STATES};
+pub use model::LoopModel;
 pub use search::{test, HiddenValveTest, TestSettings};
 
 #[cfg(test)]

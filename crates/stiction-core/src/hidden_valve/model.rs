@@ -35,7 +35,7 @@ pub struct LoopModel {
 }
 
 /// Dimension of the state: valve, process output, drifting load, cycling load (two).
-pub const STATES: usize = 5;
+pub(crate) const STATES: usize = 5;
 
 /// The model's matrices at sampling time `ts`, s.
 #[derive(Debug, Clone)]

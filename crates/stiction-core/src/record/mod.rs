@@ -16,10 +16,8 @@ mod gaps;
 mod numbers;
 mod own_times;
 mod time;
-pub use cells::{is_missing, mode_word, MISSING_MARKERS};
-pub use gaps::{
-    bridged, bridged_note, longest_clean, short_gaps, BRIDGE_MAX_RUN, BRIDGE_MAX_SHARE,
-};
+pub use cells::{is_missing, mode_word};
+pub use gaps::{bridged, bridged_note, longest_clean, short_gaps};
 pub use numbers::{parse_number, parse_number_grouped, Grouping};
 pub use own_times::OWN_TIMES_SHARE;
 use time::count;

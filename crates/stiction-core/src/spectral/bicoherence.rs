@@ -61,7 +61,7 @@ pub struct Bicoherence {
 }
 
 /// Fewest segments the bicoherence estimate is averaged over.
-pub const MIN_SEGMENTS: usize = 4;
+pub(crate) const MIN_SEGMENTS: usize = 4;
 /// Shortest segment a short record may fall back to.
 pub(super) const MIN_FALLBACK_SEGMENT: usize = 64;
 /// Shortest segment accepted at all (fewer bins leave too few bifrequencies).

@@ -35,7 +35,8 @@ mod spectrum;
 #[cfg(test)]
 mod tests;
 
-pub use bicoherence::{bicoherence, Bicoherence, BicoherenceSettings, MIN_SEGMENTS};
+pub(crate) use bicoherence::MIN_SEGMENTS;
+pub use bicoherence::{bicoherence, Bicoherence, BicoherenceSettings};
 pub use correlation::{autocorrelation, cross_correlation};
 pub use ellipse::{apparent_stiction_ellipse, fit_ellipse, Ellipse};
 pub use filter::band_pass;

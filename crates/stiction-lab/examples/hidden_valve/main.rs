@@ -17,7 +17,7 @@ use stiction_lab::catalogue_loop;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::time::Instant;
-use stiction_core::diagnose::evidence::hidden_valve::PARTICLES;
+use stiction_core::diagnose::Thresholds;
 use stiction_core::diagnose::{diagnose, Verdict};
 use stiction_core::hidden_valve::{test, Particles, Record, TestSettings};
 use stiction_lab::catalogue::{catalogue, BenchmarkLoop, Set, Suite, Truth};
@@ -86,8 +86,10 @@ fn main() {
         Some("routine") => Suite::Routine,
         _ => Suite::Fast,
     };
-    let particles: usize =
-        arg(&args, "--particles").map_or(PARTICLES, |v| v.parse().expect("--particles N"));
+    let particles: usize = arg(&args, "--particles")
+        .map_or(Thresholds::default().hidden_valve_particles, |v| {
+            v.parse().expect("--particles N")
+        });
     let sticky_starts: usize =
         arg(&args, "--sticky-starts").map_or(2, |v| v.parse().expect("--sticky-starts N"));
     let only: Vec<&String> = args
@@ -113,7 +115,7 @@ fn main() {
         } else {
             ""
         },
-        stiction_core::diagnose::evidence::hidden_valve::THRESHOLD,
+        Thresholds::default().hidden_valve_threshold,
     );
     let sets = match arg(&args, "--set") {
         Some("calibration") => vec![Set::Calibration],

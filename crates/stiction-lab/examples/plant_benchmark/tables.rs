@@ -4,7 +4,7 @@
 use super::VERDICTS;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use stiction_core::diagnose::{Diagnosis, Verdict, Vote};
+use stiction_core::diagnose::{Diagnosis, Thresholds, Verdict, Vote};
 use stiction_lab::catalogue::{BenchmarkLoop, LoopClass, NoiseLevel, Suite, Truth};
 
 /// The results by class, in the catalogue's class order.
@@ -33,10 +33,10 @@ pub(super) fn by_class<'a>(loops: &'a [BenchmarkLoop], res: &'a [(Diagnosis, f64
 
 /// With `--thorough`: the levels test's ratio per class (loops where it ran).
 pub(super) fn levels_table(md: &mut String, groups: &Groups) {
+    let levels_stiction = Thresholds::default().levels_stiction;
     let _ = writeln!(
         md,
-        "The levels test's ratio (loops where it ran; it votes stiction from {:.0}):\n",
-        stiction_core::diagnose::evidence::model::LEVELS_STICTION
+        "The levels test's ratio (loops where it ran; it votes stiction from {levels_stiction:.0}):\n"
     );
     let _ = writeln!(
         md,
@@ -59,10 +59,7 @@ pub(super) fn levels_table(md: &mut String, groups: &Groups) {
                 .copied()
                 .unwrap_or(f64::NAN)
         };
-        let above = r
-            .iter()
-            .filter(|&&x| x >= stiction_core::diagnose::evidence::model::LEVELS_STICTION)
-            .count();
+        let above = r.iter().filter(|&&x| x >= levels_stiction).count();
         let _ = writeln!(
             md,
             "| {class} | {} of {} | {:.1} | {:.1} | {above} |",
@@ -77,13 +74,14 @@ pub(super) fn levels_table(md: &mut String, groups: &Groups) {
 
 /// With `--thorough`: the hidden-valve family per class (where it ran, its ratio, its votes).
 pub(super) fn hidden_valve_table(md: &mut String, groups: &Groups) {
-    use stiction_core::diagnose::evidence::hidden_valve::{DRAWS, THRESHOLD};
+    let t = Thresholds::default();
+    let (threshold, draws) = (t.hidden_valve_threshold, t.hidden_valve_draws);
     use stiction_core::diagnose::{Family, Vote};
     let _ = writeln!(
         md,
         "The hidden-valve family (with `--thorough`; it runs where the other families have not decided `stiction`, on an oscillating \
-         loop with PV recorded and OP within 10 % of span, and votes stiction from a ratio of {THRESHOLD:.0}, the median of {DRAWS} draws of \
-         the particle filter's noise where the first reaches it; the ratios below are the median where there were {DRAWS}):\n"
+         loop with PV recorded and OP within 10 % of span, and votes stiction from a ratio of {threshold:.0}, the median of {draws} draws of \
+         the particle filter's noise where the first reaches it; the ratios below are the median where there were {draws}):\n"
     );
     let _ = writeln!(
         md,

@@ -5,8 +5,9 @@ mod record;
 mod shape;
 mod thorough;
 
-use stiction_core::diagnose::evidence::stick_slip::PV_BAND_SIGMAS;
-use stiction_core::diagnose::{diagnose, DiagnoseRequest, Family, LoopRecord, Verdict, Vote};
+use stiction_core::diagnose::{
+    diagnose, DiagnoseRequest, Family, LoopRecord, Thresholds, Verdict, Vote,
+};
 use stiction_core::models::{Model, Stenman};
 use stiction_core::quality::Gate;
 use stiction_core::sim::{ClosedLoop, LoopData, Process, Signal};

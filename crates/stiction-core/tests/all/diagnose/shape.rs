@@ -109,7 +109,8 @@ fn a_levels_stick_slip_episodes_are_judged_on_the_level_itself() {
         .find(|f| f.family == Family::StickSlip)
         .unwrap();
     let e = f.stick_slip.as_ref().unwrap();
-    let band = PV_BAND_SIGMAS * stiction_core::detect::measurement_noise(&sticky.pv);
+    let band =
+        Thresholds::default().pv_band_sigmas * stiction_core::detect::measurement_noise(&sticky.pv);
     assert!(
         (e.pv_band - band).abs() < 1e-12,
         "{} against {band}",

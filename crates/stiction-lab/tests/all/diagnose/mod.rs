@@ -8,13 +8,9 @@ mod record;
 mod shape;
 mod thorough;
 
-use stiction_core::diagnose::evidence::model::{
-    CYCLE_CANCELLED_STICTION, FORCED_REGULARITY, FOREIGN_SHAPE, SIGNIFICANCE_NONE,
-    SIGNIFICANCE_STICTION,
-};
 use stiction_core::diagnose::{
-    diagnose, BandSource, DiagnoseRequest, Diagnosis, Family, FamilyEvidence, LoopRecord, Verdict,
-    Vote,
+    diagnose, BandSource, DiagnoseRequest, Diagnosis, Family, FamilyEvidence, LoopRecord,
+    Thresholds, Verdict, Vote,
 };
 use stiction_core::models::{Model, Stenman};
 use stiction_core::quality::Gate;
@@ -39,6 +35,11 @@ pub(crate) fn record(l: &LoopData) -> LoopRecord<'_> {
         time: Some(&l.t),
         auto: None,
     }
+}
+
+/// The thresholds `diagnose` applies.
+fn thresholds() -> Thresholds {
+    Thresholds::default()
 }
 
 fn quick() -> DiagnoseRequest {

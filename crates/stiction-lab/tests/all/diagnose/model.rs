@@ -49,10 +49,7 @@ fn a_lag_at_its_bound_is_also_compared_over_a_third_of_it() {
     let m = model_family(&d);
     let e = m.model.as_ref().unwrap();
     assert_eq!(e.lag_bound, Some(200), "{}", m.note);
-    assert_eq!(
-        e.lag,
-        200 / stiction_core::diagnose::evidence::model::BOUND_LAG_DIVISOR
-    );
+    assert_eq!(e.lag, 200 / thresholds().bound_lag_divisor);
     assert_eq!(m.vote, Vote::Stiction, "{}", m.note);
     assert!(m.note.contains("a third of the bound"), "{}", m.note);
     assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
@@ -93,7 +90,8 @@ fn a_limit_cycle_whose_fit_falls_short_of_a_vote_is_compared_over_whole_periods(
     let model = found_over_whole_periods("routine-x1-0017");
     let m = model.model.as_ref().unwrap();
     assert!(
-        m.significance > SIGNIFICANCE_NONE && m.significance < SIGNIFICANCE_STICTION,
+        m.significance > thresholds().significance_none
+            && m.significance < thresholds().significance_stiction,
         "{}",
         model.note
     );
@@ -113,8 +111,14 @@ fn the_comparison_over_whole_periods_votes_at_the_first_comparisons_threshold() 
         .cycle_cancelled
         .clone()
         .unwrap();
-    assert!(c.significance < 2.0 * SIGNIFICANCE_STICTION, "{c:?}");
-    assert_eq!(CYCLE_CANCELLED_STICTION, SIGNIFICANCE_STICTION);
+    assert!(
+        c.significance < 2.0 * thresholds().significance_stiction,
+        "{c:?}"
+    );
+    assert_eq!(
+        thresholds().cycle_cancelled_stiction,
+        thresholds().significance_stiction
+    );
 }
 
 #[test]
@@ -127,7 +131,11 @@ fn an_oscillation_whose_period_wanders_is_compared_over_whole_periods_too() {
     assert!(o.oscillating && o.regularity.regularity < 5.0, "{o:?}");
     let model = found_over_whole_periods("fast-x1-0010");
     let m = model.model.as_ref().unwrap();
-    assert!(m.significance <= SIGNIFICANCE_NONE, "{}", model.note);
+    assert!(
+        m.significance <= thresholds().significance_none,
+        "{}",
+        model.note
+    );
 }
 
 /// The model family's evidence on a catalogue loop it finds sticky by comparing the fits over
@@ -137,7 +145,10 @@ fn found_over_whole_periods(id: &str) -> stiction_core::diagnose::evidence::Fami
     let model = model_family(&d).clone();
     let c = model.model.as_ref().and_then(|m| m.cycle_cancelled.clone());
     let c = c.unwrap_or_else(|| panic!("{id}: {}", model.note));
-    assert!(c.significance >= CYCLE_CANCELLED_STICTION, "{id}: {c:?}");
+    assert!(
+        c.significance >= thresholds().cycle_cancelled_stiction,
+        "{id}: {c:?}"
+    );
     assert_eq!(model.vote, Vote::Stiction, "{id}: {}", model.note);
     assert_eq!(d.verdict, Verdict::Stiction, "{id}: {:?}", d.evidence);
     model
@@ -225,7 +236,10 @@ fn a_band_that_only_fits_a_clock_regular_cycle_is_no_vote() {
     let d = judge_catalogue("routine-c-0465");
     let model = model_family(&d);
     let osc = d.oscillation.as_ref().unwrap();
-    assert!(osc.regularity.regularity >= FORCED_REGULARITY, "{osc:?}");
+    assert!(
+        osc.regularity.regularity >= thresholds().forced_regularity,
+        "{osc:?}"
+    );
     let m = model.model.as_ref().unwrap();
     assert!(m.significance >= 50.0, "{}", model.note);
     assert!(
@@ -255,7 +269,9 @@ fn a_band_that_only_fits_a_clock_regular_cycle_is_no_vote() {
     // Kano valve, regularity 128, the band gaining 16 % of the PV's variation)
     let d = judge_catalogue("fast-c-0047");
     let model = model_family(&d);
-    assert!(d.oscillation.as_ref().unwrap().regularity.regularity >= FORCED_REGULARITY);
+    assert!(
+        d.oscillation.as_ref().unwrap().regularity.regularity >= thresholds().forced_regularity
+    );
     let c = model.model.as_ref().unwrap().cycle_cancelled.clone();
     assert!(c.is_some_and(|c| c.significance > 15.0), "{}", model.note);
     assert!(!model.model.as_ref().unwrap().gain_in_a_clock_regular_cycle);
@@ -290,14 +306,18 @@ fn a_band_whose_steps_the_recorded_cycle_lacks_is_no_vote() {
     let d = diagnose(&record(&l), &quick()).unwrap();
     let model = model_family(&d);
     let m = model.model.as_ref().unwrap();
-    assert!(m.significance >= SIGNIFICANCE_STICTION, "{}", model.note);
+    assert!(
+        m.significance >= thresholds().significance_stiction,
+        "{}",
+        model.note
+    );
     let shape = m
         .cycle_shape
         .as_ref()
         .expect("the cycle's shape is checked");
     assert!(shape.foreign(), "{shape:?}");
     assert!(
-        shape.fit_harmonics >= FOREIGN_SHAPE * shape.pv_harmonics,
+        shape.fit_harmonics >= thresholds().foreign_shape * shape.pv_harmonics,
         "{shape:?}"
     );
     assert_eq!(model.vote, Vote::Undetermined, "{}", model.note);
@@ -332,10 +352,7 @@ fn a_fit_that_mirrors_the_controller_casts_no_stiction_vote() {
     let d = judged_with_the_fit_withdrawn("routine-c-0490");
     let m = model_family(&d);
     let g = m.model.as_ref().unwrap().loop_gain.unwrap();
-    assert!(
-        g < stiction_core::diagnose::evidence::model::MIN_LOOP_GAIN,
-        "{g}"
-    );
+    assert!(g < thresholds().min_loop_gain, "{g}");
     assert!(m.note.contains("loop gain"), "{}", m.note);
     assert!(m.model.as_ref().unwrap().fit_mirrors_controller);
     // routine-c-0507: the withdrawn vote was the only one; the verdict says so instead of calling

@@ -1,7 +1,6 @@
 //! `thorough`: the levels test and the hidden valve.
 
 use super::*;
-use stiction_core::diagnose::evidence::hidden_valve::THRESHOLD;
 use stiction_core::diagnose::evidence::HiddenValveEvidence;
 
 #[test]
@@ -39,7 +38,8 @@ fn thorough_finds_a_valve_that_slips_between_the_samples() {
     assert_eq!(hidden.vote, Vote::Stiction, "{}", hidden.note);
     let h = hidden.hidden_valve.as_ref().unwrap();
     assert!(
-        h.ratio >= THRESHOLD && (0.5..4.0).contains(&h.band_percent_of_span),
+        h.ratio >= thresholds().hidden_valve_threshold
+            && (0.5..4.0).contains(&h.band_percent_of_span),
         "{h:?}"
     );
     // a first ratio past the threshold is drawn three times in all; the median decides
@@ -109,7 +109,7 @@ fn judged_under_the_threshold(id: &str) -> HiddenValveEvidence {
     let hidden = hidden_valve_of(&d);
     assert_eq!(hidden.vote, Vote::Undetermined, "{}", hidden.note);
     let h = hidden.hidden_valve.clone().unwrap();
-    assert!(h.ratio < THRESHOLD, "{h:?}");
+    assert!(h.ratio < thresholds().hidden_valve_threshold, "{h:?}");
     h
 }
 

@@ -20,7 +20,7 @@ use super::Levels;
 use crate::quantify::{compare_fits, max_lag, off_the_pv_cycle, CompareRequest, FitComparison};
 
 /// Where the lag reaches its bound, the changes are also compared over the bound divided by this.
-pub const BOUND_LAG_DIVISOR: usize = 3;
+pub(crate) const BOUND_LAG_DIVISOR: usize = 3;
 
 /// The fits compared as [`compare_fits`] compares them, and again over a third of the lag where
 /// it reached its bound (a lag the caller set is kept): the comparison with the higher test

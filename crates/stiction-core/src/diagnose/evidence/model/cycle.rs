@@ -27,7 +27,7 @@ use crate::quantify::{compare_fits, CompareRequest, FitComparison};
 use serde::{Deserialize, Serialize};
 
 /// The test's ratio at and above which the comparison over whole periods votes stiction.
-pub const CYCLE_CANCELLED_STICTION: f64 = SIGNIFICANCE_STICTION;
+pub(crate) const CYCLE_CANCELLED_STICTION: f64 = SIGNIFICANCE_STICTION;
 
 /// A cycle at least this regular (Thornhill's r: its period's standard deviation under a 300th
 /// of the period) keeps time like an input of fixed period, or like a limit cycle the noise
@@ -48,14 +48,14 @@ pub const CYCLE_CANCELLED_STICTION: f64 = SIGNIFICANCE_STICTION;
 /// nothing else moves. Over the calibration set and nine further draws of it, 3 more of the 300
 /// externally oscillating routine windows are not called sticky, and no sticky loop loses its
 /// stiction verdict.
-pub const FORCED_REGULARITY: f64 = 100.0;
+pub(crate) const FORCED_REGULARITY: f64 = 100.0;
 /// ... measured over at least this many zero crossings of the autocorrelation (two periods: a
 /// regularity from fewer measures no spread).
-pub const FORCED_CROSSINGS: usize = crate::detect::SPREAD_CROSSINGS;
+pub(crate) const FORCED_CROSSINGS: usize = crate::detect::SPREAD_CROSSINGS;
 /// ... and the band's gain over the linear loop at least this share of the PV's variation above
 /// its noise (a band that reshapes the fit of so regular a cycle by a twentieth of it; the
 /// externally oscillating loops gain 7.8 % and more).
-pub const FORCED_GAIN: f64 = 0.05;
+pub(crate) const FORCED_GAIN: f64 = 0.05;
 
 /// Whether the cycle keeps time like an input of fixed period ([`FORCED_REGULARITY`]).
 pub(super) fn clock_regular(ctx: &Context) -> bool {

@@ -31,10 +31,10 @@ use serde::{Deserialize, Serialize};
 /// The fitted valve's PV must carry at least this share of its cycle's power in harmonics 2 to
 /// 5 (the shape family's bound of a sinusoid): a fit whose PV is itself sinusoidal has no shape
 /// to miss.
-pub const FIT_HARMONICS: f64 = SINUSOIDAL_HARMONICS;
+pub(crate) const FIT_HARMONICS: f64 = SINUSOIDAL_HARMONICS;
 /// ... and this many times those of the recorded PV: above every sticky valve of the
 /// catalogue's calibration draws (the largest 4.5).
-pub const FOREIGN_SHAPE: f64 = 5.0;
+pub(crate) const FOREIGN_SHAPE: f64 = 5.0;
 
 /// The harmonics of the cycle in the fitted valve's PV and in the recorded PV.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

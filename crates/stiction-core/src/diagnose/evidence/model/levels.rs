@@ -32,11 +32,11 @@ use crate::quantify::FitComparison;
 use serde::{Deserialize, Serialize};
 
 /// The levels test's ratio at and above which it votes stiction.
-pub const LEVELS_STICTION: f64 = 50.0;
+pub(crate) const LEVELS_STICTION: f64 = 50.0;
 /// The ratio at which its vote is held with full strength.
-pub const LEVELS_DECISIVE: f64 = 500.0;
+pub(crate) const LEVELS_DECISIVE: f64 = 500.0;
 /// Above this share of PV samples not recorded the test is not run.
-pub const MAX_UNRECORDED: f64 = 0.2;
+pub(crate) const MAX_UNRECORDED: f64 = 0.2;
 
 /// What the levels test found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -20,7 +20,7 @@ use crate::quantify::FitComparison;
 /// false alarms fall from 14 to 8 and no sticky loop's verdict moves; limit cycles are left
 /// alone (there the valve drives the loop, and a PI read off fast samples is unreliable: two
 /// sticky fast loops would lose their verdict).
-pub const MIN_LOOP_GAIN: f64 = 0.1;
+pub(crate) const MIN_LOOP_GAIN: f64 = 0.1;
 
 /// Why a stiction vote is withdrawn ([`mirrors_controller`], then [`moved_elsewhere`]), with the
 /// evidence's flag set; `None` when it stands.

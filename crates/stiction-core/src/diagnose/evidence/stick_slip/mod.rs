@@ -22,9 +22,9 @@ use serde::{Deserialize, Serialize};
 pub struct StickSlip;
 
 /// Half-width of the PV's noise band, in noise standard deviations.
-pub const PV_BAND_SIGMAS: f64 = 2.5;
+pub(crate) const PV_BAND_SIGMAS: f64 = 2.5;
 /// OP must travel more than this many of its noise standard deviations in an episode.
-pub const OP_TRAVEL_SIGMAS: f64 = 4.0;
+pub(crate) const OP_TRAVEL_SIGMAS: f64 = 4.0;
 /// Strength of a stiction vote: below what a verdict needs on its own (see the verdict).
 const STICTION_STRENGTH: f64 = 0.4;
 /// From this many episodes holding at least [`DECISIVE_SHARE`] of the OP's travel the vote is
@@ -33,21 +33,21 @@ const STICTION_STRENGTH: f64 = 0.4;
 /// not-sticky loop with 20 episodes or more spends more than 66 % of the OP's travel in them (the
 /// highest: an equal-percentage valve, 66 %, a saturating OP, 64 %, an external oscillation,
 /// 62 %); 36 sticky loops and 1 backlash valve reach 20 episodes holding 70 % or more.
-pub const DECISIVE_EPISODES: usize = 20;
+pub(crate) const DECISIVE_EPISODES: usize = 20;
 /// See [`DECISIVE_EPISODES`].
-pub const DECISIVE_SHARE: f64 = 0.7;
+pub(crate) const DECISIVE_SHARE: f64 = 0.7;
 /// Strength of a stiction vote from [`DECISIVE_EPISODES`] episodes: above the verdict's need.
 const DECISIVE_STRENGTH: f64 = 0.6;
 /// Episodes at and above which the family votes stiction ...
-pub const MIN_EPISODES: usize = 5;
+pub(crate) const MIN_EPISODES: usize = 5;
 /// ... when at least this share of the OP's travel was spent stuck.
-pub const MIN_STUCK_SHARE: f64 = 0.5;
+pub(crate) const MIN_STUCK_SHARE: f64 = 0.5;
 /// At most this many episodes, with at least this share of OP travel ...
-pub const MAX_EPISODES_NONE: usize = 1;
+pub(crate) const MAX_EPISODES_NONE: usize = 1;
 /// ... over at least this many quiet stretches, vote against stiction ...
-pub const MIN_STRETCHES_NONE: usize = 10;
+pub(crate) const MIN_STRETCHES_NONE: usize = 10;
 /// ... in a record of at least this many samples (a short record shows few sticks either way).
-pub const MIN_SAMPLES_NONE: usize = 400;
+pub(crate) const MIN_SAMPLES_NONE: usize = 400;
 
 /// What the episodes show.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -79,7 +79,7 @@ pub struct StickSlipEvidence {
 }
 
 mod episodes;
-pub use episodes::{episodes, Settings, SLIP_SHARE};
+pub use episodes::{episodes, Settings};
 
 /// The family's vote on its episodes (over a record of `samples`), its strength and why.
 fn ballot(e: &StickSlipEvidence, samples: usize) -> (Vote, f64, String) {
