@@ -64,20 +64,20 @@ impl Regularity {
 }
 
 /// Default threshold on Thornhill's r.
-pub(crate) const REGULARITY_THRESHOLD: f64 = 1.0;
+pub(super) const REGULARITY_THRESHOLD: f64 = 1.0;
 
 /// The largest regularity reported (perfectly regular periods).
-pub(crate) const REGULARITY_CAP: f64 = 1e6;
+pub(super) const REGULARITY_CAP: f64 = 1e6;
 
 /// Zero crossings of the autocorrelation used for the periods (about five periods).
-pub(crate) const MAX_CROSSINGS: usize = 11;
+const MAX_CROSSINGS: usize = 11;
 
 /// The shortest period a sampled cycle can have, samples (the Nyquist limit).
-pub(crate) const MIN_PERIOD_SAMPLES: f64 = 2.0;
+const MIN_PERIOD_SAMPLES: f64 = 2.0;
 
 /// Zero crossings of the autocorrelation that span two periods: a regularity from fewer
 /// measures no spread of the periods.
-pub(crate) const SPREAD_CROSSINGS: usize = 5;
+pub(super) const SPREAD_CROSSINGS: usize = 5;
 
 /// The standard deviation of white measurement noise on `x`, robustly: the smaller of the
 /// estimates from first differences (MAD / 0.6745 / √2) and from second differences
@@ -109,7 +109,7 @@ pub fn measurement_noise(x: &[f64]) -> f64 {
 
 /// A held signal repeats its value in at least this share of its samples (a controller slower
 /// than the record, or a historian that stores a value only when it changes).
-pub(crate) const HELD_SHARE: f64 = 0.3;
+const HELD_SHARE: f64 = 0.3;
 
 /// The noise of a signal that may be held between updates (OP recorded faster than the
 /// controller runs): [`measurement_noise`], except that where at least [`HELD_SHARE`] of the

@@ -213,9 +213,9 @@ pub fn rank(rows: &mut [Row]) {
 /// cascade's setpoint) keeps its period, but its estimate in a loop it reaches scatters (the
 /// `propagated_oscillation` example: 54 % of the regular ones within 5 % of the source's period,
 /// 73 % within 10 %).
-pub(crate) const SAME_PERIOD: f64 = 0.10;
+const SAME_PERIOD: f64 = 0.10;
 /// A loop's cycle counts from this regularity (Thornhill's: over 1, a regular oscillation).
-pub(crate) const REGULAR: f64 = 1.0;
+const REGULAR: f64 = 1.0;
 
 /// For each row, how many other rows oscillate at its period ([`SAME_PERIOD`]; both regular,
 /// [`REGULAR`]); 0 for a row that does not oscillate. Where several loops of one unit share a

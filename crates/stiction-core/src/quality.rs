@@ -320,14 +320,14 @@ pub fn unrecorded(x: &[f64]) -> Vec<bool> {
 }
 
 /// A spike is at most this many samples long.
-pub(crate) const SPIKE_RUN: usize = 3;
+const SPIKE_RUN: usize = 3;
 /// A spike leaves the signal's own range (1st to 99th percentile) by more than this many times
 /// that range: historian junk (0, -9999, 1e6) does by far; a quantised PV's step to a level the
 /// percentiles leave out, or a process's own peak, does not.
-pub(crate) const SPIKE_RANGES: f64 = 3.0;
+const SPIKE_RANGES: f64 = 3.0;
 /// Spikes are rare: when more samples than this share would be spikes, the signal is taken as
 /// it is (they are its own behaviour, not glitches) and none is marked.
-pub(crate) const SPIKE_SHARE: f64 = 0.01;
+const SPIKE_SHARE: f64 = 0.01;
 
 /// The samples of `x` that are spikes: runs of at most [`SPIKE_RUN`] samples beyond the
 /// signal's 1st to 99th percentile range by more than [`SPIKE_RANGES`] times that range, with
@@ -381,7 +381,7 @@ pub(crate) fn readable(v: f64) -> String {
 }
 
 /// Runs of at least this many samples on one straight line count as not recorded.
-pub(crate) const MIN_STRAIGHT: usize = 5;
+const MIN_STRAIGHT: usize = 5;
 
 /// The resolution of a quantised signal: the smallest step between consecutive samples, when at
 /// least a third of the steps are zero and every other step is a whole multiple of it.

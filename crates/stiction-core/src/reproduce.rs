@@ -11,7 +11,7 @@ use crate::sim::{simulate_open_loop, LoopData, Signal};
 use serde::{Deserialize, Serialize};
 
 /// The paper's Table 2: (true d, the paper's estimate).
-pub(crate) const PAPER_TABLE_2: [(f64, f64); 2] = [(0.2, 0.2), (0.5, 0.48)];
+const PAPER_TABLE_2: [(f64, f64); 2] = [(0.2, 0.2), (0.5, 0.48)];
 
 /// How the paper's open-loop cases are reproduced: the command, its sampling, the seeds and the ACO
 /// settings.

@@ -7,14 +7,14 @@ use crate::sim::LoopData;
 use serde::{Deserialize, Serialize};
 
 /// The controller output's limits in the closed-loop simulation (% of span).
-pub(crate) const OP_LIMITS: (f64, f64) = (0.0, 100.0);
+const OP_LIMITS: (f64, f64) = (0.0, 100.0);
 
 /// The share of samples with OP at a limit from which a loop counts as saturated.
 pub const SATURATION_LIMIT: f64 = 0.05;
 
 /// How much larger the control error's RMS must be in the last quarter of the record than in the
 /// second quarter for the loop to count as unstable.
-pub(crate) const GROWTH_LIMIT: f64 = 2.0;
+const GROWTH_LIMIT: f64 = 2.0;
 
 /// How the loop's control error evolves over the record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

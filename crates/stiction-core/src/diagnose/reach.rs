@@ -12,12 +12,12 @@ use serde::{Deserialize, Serialize};
 /// A small band: under this many OP noise standard deviations.
 pub const SMALL: f64 = 4.0;
 /// A large band: over this many OP noise standard deviations.
-pub(crate) const LARGE: f64 = 12.0;
+const LARGE: f64 = 12.0;
 /// The shares of simulated sticky valves with a small band called `stiction` (routine windows
 /// at 10 s and 1 s, fast limit cycles: the lowest and the highest).
 pub const FOUND_SMALL: [f64; 2] = [0.12, 0.41];
 /// The same for large bands.
-pub(crate) const FOUND_LARGE: [f64; 2] = [0.75, 0.95];
+const FOUND_LARGE: [f64; 2] = [0.75, 0.95];
 
 /// How the figures of [`Reach`] were set.
 const CALIBRATION: &str = "the catalogue's simulated sticky valves, its calibration set and draws 1-3 (routine windows of 750 samples at 10 s and 2,000 at 1 s, fast loops that limit-cycle): bands under 4 OP noise standard deviations called stiction in 12 % (10 s), 14 % (1 s) and 41 % (fast), bands over 12 in 75 %, 82 % and 95 %";

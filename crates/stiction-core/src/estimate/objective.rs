@@ -11,10 +11,10 @@ use crate::models::{Choudhury, He, Kano, ModelKind, Stenman, StictionModel};
 use rayon::prelude::*;
 
 /// Candidates advanced together in one pass over the data.
-pub(crate) const LANES: usize = 8;
+const LANES: usize = 8;
 
 /// Stenman candidates per pass: more independent chains hide the latency of the select.
-pub(crate) const STENMAN_LANES: usize = 16;
+const STENMAN_LANES: usize = 16;
 
 /// Work (samples x candidates) above which a batch is spread over threads.
 const PARALLEL_WORK: usize = 1 << 21;

@@ -35,7 +35,7 @@ pub struct LoopModel {
 }
 
 /// Dimension of the state: valve, process output, drifting load, cycling load (two).
-pub(crate) const STATES: usize = 5;
+pub(super) const STATES: usize = 5;
 
 /// The model's matrices at sampling time `ts`, s.
 #[derive(Debug, Clone)]
@@ -80,7 +80,7 @@ impl LoopModel {
 }
 
 /// PV is the process output plus both loads plus noise.
-pub(super) const H: [f64; STATES] = [0.0, 1.0, 1.0, 1.0, 0.0];
+const H: [f64; STATES] = [0.0, 1.0, 1.0, 1.0, 0.0];
 
 /// The Kalman gains and innovation variances of the model, step by step until they settle (the
 /// covariance does not depend on the data, so every particle and every input shares them).

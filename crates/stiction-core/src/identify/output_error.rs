@@ -163,7 +163,7 @@ pub fn polish_output_error(data: &Data, mv: &[f64], start: &Fit) -> Option<Fit> 
 }
 
 /// Levenberg-Marquardt iterations on the simulation error after Steiglitz-McBride.
-pub(super) const LM_ITERATIONS: usize = 12;
+const LM_ITERATIONS: usize = 12;
 /// ... stopped after a step that lowers the error by at most this share of it. Measured on the
 /// plant benchmark's four sets (`plant_benchmark --jsonl`, routine and fast, calibration and
 /// benchmark, 1,560 loops): at a millionth no verdict moves and 41 bands move a little (none

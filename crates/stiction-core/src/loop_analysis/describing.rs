@@ -123,7 +123,7 @@ const LOCUS_POINTS: usize = 48;
 const LOCUS_FIRST: f64 = 0.52;
 const LOCUS_LAST: f64 = 40.0;
 /// Kano's slip ratios J / S whose loci span the valves between a backlash and a stick-jump.
-pub(crate) const SLIP_RATIOS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+const SLIP_RATIOS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
 
 /// A valve's describing function along a grid of amplitude over band.
 #[derive(Debug, Clone, PartialEq)]

@@ -4,7 +4,7 @@
 /// Cell texts read as a missing value (compared case-insensitively, after trimming). The last
 /// ones are OSIsoft PI's system digital states for a failed or absent reading, and Excel's cell
 /// errors.
-pub(crate) const MISSING_MARKERS: &[&str] = &[
+const MISSING_MARKERS: &[&str] = &[
     "",
     "nan",
     "-nan",

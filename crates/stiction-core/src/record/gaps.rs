@@ -6,9 +6,9 @@
 //! [`BRIDGE_MAX_SHARE`] of the record. Longer gaps, or more of them, are left to split it.
 
 /// The longest run of rows bridged.
-pub(crate) const BRIDGE_MAX_RUN: usize = 3;
+const BRIDGE_MAX_RUN: usize = 3;
 /// Bridged rows may be at most this share of the record.
-pub(crate) const BRIDGE_MAX_SHARE: f64 = 0.01;
+const BRIDGE_MAX_SHARE: f64 = 0.01;
 
 /// The longest run of rows `[start, end)` where every column holds a finite value (the first such
 /// run when several are equally long); `None` when no row does. Fits (`quantify`, `estimate`)

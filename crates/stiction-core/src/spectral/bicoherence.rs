@@ -63,14 +63,14 @@ pub struct Bicoherence {
 /// Fewest segments the bicoherence estimate is averaged over.
 pub(crate) const MIN_SEGMENTS: usize = 4;
 /// Shortest segment a short record may fall back to.
-pub(super) const MIN_FALLBACK_SEGMENT: usize = 64;
+const MIN_FALLBACK_SEGMENT: usize = 64;
 /// Shortest segment accepted at all (fewer bins leave too few bifrequencies).
-pub(super) const MIN_SEGMENT: usize = 16;
+const MIN_SEGMENT: usize = 16;
 /// Fraction of the squared bicoherence values trimmed from each end for the robust statistics.
-pub(super) const TRIM: f64 = 0.1;
+const TRIM: f64 = 0.1;
 /// Denominator floor relative to its largest value: bins with only rounding-level power must not
 /// produce bicoherence near 1 (or 0/0).
-pub(super) const DENOMINATOR_FLOOR: f64 = 1e-20;
+const DENOMINATOR_FLOOR: f64 = 1e-20;
 
 /// Squared bicoherence over the principal domain, with the bookkeeping the indices need.
 pub(super) struct BicoherenceMap {

@@ -39,7 +39,7 @@ pub enum Scale {
 }
 
 /// What a shape index reads where it was not computed (below every index's range).
-pub(crate) const NOT_COMPUTED: f64 = -9.0;
+pub(super) const NOT_COMPUTED: f64 = -9.0;
 
 impl Scale {
     /// A value read on this scale, back on its own.
@@ -53,7 +53,7 @@ impl Scale {
 }
 
 /// The statistics' names (the trees' inputs, in order), each in words, and how it is read.
-pub(crate) const NAMES: [(&str, &str, Scale); COUNT] = [
+pub(super) const NAMES: [(&str, &str, Scale); COUNT] = [
     (
         "model_test_ratio",
         "the closed-loop fit's test ratio",

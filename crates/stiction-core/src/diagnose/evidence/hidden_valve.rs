@@ -41,11 +41,11 @@ pub(crate) const THRESHOLD: f64 = 75.0;
 /// leaves the family silent: on the routine calibration windows an equal-percentage valve under a
 /// load ramp (OP over 14 % of span) reached a ratio of 288; the sticky valves the family found
 /// moved OP over at most 6.5 %.
-pub(crate) const MAX_OP_TRAVEL: f64 = 0.10;
+const MAX_OP_TRAVEL: f64 = 0.10;
 /// PV samples not recorded (runs of repeats or exactly straight lines) above this share leave the
 /// family silent: a held or straight-lined PV is no Gaussian measurement, and compressed records
 /// reach ratios in the thousands (stiction-lab/results/hidden-valve-routine.md).
-pub(crate) const MAX_UNRECORDED: f64 = 0.05;
+const MAX_UNRECORDED: f64 = 0.05;
 /// Particles of the sticky hypothesis's filter (the calibrated setting). 100 before: on the fast
 /// calibration and benchmark sets' 113 loops the family judges, 50 call the same sticky loops
 /// sticky (one more) and leave every look-alike under the threshold, at half the cost.
@@ -54,7 +54,7 @@ pub(crate) const PARTICLES: usize = 50;
 /// ([`TestSettings::band_starts`]). With the best alone the search stayed at a small band on
 /// three of four seeds of ISDB loop PAP2 (ratios near -12; the fourth 182), with both every seed
 /// found a ratio of 149 to 179.
-pub(crate) const BAND_STARTS: usize = 2;
+const BAND_STARTS: usize = 2;
 /// Draws of the particle filter's noise (seeds 1, 2, ...) whose median ratio decides a stiction
 /// vote: a ratio at or above the threshold is drawn again with other seeds. On the 249 loops the
 /// family judged on the four plant-benchmark sets, one draw against another moved 12 votes
@@ -66,7 +66,7 @@ pub(crate) const BAND_STARTS: usize = 2;
 pub(crate) const DRAWS: u64 = 3;
 /// How far short of OP the hidden valve's slips may land, as shares of its band (0: Stenman's
 /// valve; He's lands `fd` short).
-pub(crate) const SHORT_SHARES: &[f64] = &[0.0, 0.35, 0.7];
+const SHORT_SHARES: &[f64] = &[0.0, 0.35, 0.7];
 
 /// What the hidden-valve test found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -303,7 +303,7 @@ pub fn indices(
 
 /// Harmonics below this share of the fundamental's power, in OP and in PV, make an oscillation
 /// sinusoidal: less than a triangle wave's 1/81 + 1/625 = 0.014.
-pub(crate) const SINUSOIDAL_HARMONICS: f64 = 0.01;
+pub(super) const SINUSOIDAL_HARMONICS: f64 = 0.01;
 
 /// A sticky valve moves in jumps, which put harmonics of the oscillation into MV and so into PV
 /// and, through the controller, OP (the effect the bicoherence test looks for through phase

@@ -13,12 +13,12 @@ use serde::{Deserialize, Serialize};
 pub struct Valve;
 
 /// A band at least this many MV noise standard deviations ...
-pub(crate) const BAND_NOISE_SIGMAS: f64 = 4.0;
+const BAND_NOISE_SIGMAS: f64 = 4.0;
 /// ... and at least this share of the valve span (%) votes stiction, when the band removes at
 /// least `MIN_IMPROVEMENT` of the misfit of a valve that follows OP.
-pub(crate) const MIN_BAND_PERCENT: f64 = 0.2;
+pub(super) const MIN_BAND_PERCENT: f64 = 0.2;
 /// The share of the misfit of a valve that follows OP that the band must remove to vote stiction.
-pub(crate) const MIN_IMPROVEMENT: f64 = 0.3;
+const MIN_IMPROVEMENT: f64 = 0.3;
 
 /// The valve position against OP.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -142,7 +142,7 @@ enum Crossings {
 
 /// The band the zero crossings are read through, in standard errors of a white noise's
 /// autocorrelation at a lag (1/√n for a stretch of n samples).
-pub(crate) const CROSSING_BAND: f64 = 1.0;
+const CROSSING_BAND: f64 = 1.0;
 
 /// A cycle found only through the band holds at least this share of the error's variance (a
 /// load's steps or a slow drift can leave a regular-looking autocorrelation with almost none).
@@ -158,7 +158,7 @@ pub(crate) const CROSSING_BAND: f64 = 1.0;
 /// (4,560 loops): 9 more sticky valves called `stiction` (3 of the routine benchmark's), and two
 /// look-alikes (a narrow-band load cycle at 10 s and a noisy healthy fast loop, both on the shape
 /// indices' vote) and a backlash-only valve; the ISDB and the 108 loops: no verdict changed.
-pub(crate) const BANDED_CYCLE_SHARE: f64 = 0.05;
+const BANDED_CYCLE_SHARE: f64 = 0.05;
 
 /// The oscillation of the record with its crossings read as `crossings` says: on the longest
 /// hold of the setpoint, else across the steps, else on another hold (see [`of_record`]).

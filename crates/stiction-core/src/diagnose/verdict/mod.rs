@@ -26,7 +26,7 @@ pub(super) struct Decision {
 /// A side of a conflict wins when its total strength is at least this many times the other's and
 /// no single vote against it is stronger than `WEAK_DISSENT`.
 const DOMINANCE: f64 = 1.0;
-pub(crate) const WEAK_DISSENT: f64 = 0.5;
+pub(super) const WEAK_DISSENT: f64 = 0.5;
 /// A stiction verdict needs at least one vote this strong.
 const DECIDES: f64 = 0.5;
 

@@ -36,11 +36,11 @@ use linalg::*;
 pub use walk::{levels_walk, LevelsWalk};
 
 /// Time constants of the filter bank, samples.
-pub(crate) const TAUS: [f64; 6] = [0.5, 2.0, 6.0, 18.0, 54.0, 160.0];
+const TAUS: [f64; 6] = [0.5, 2.0, 6.0, 18.0, 54.0, 160.0];
 /// Pure delays of the bank, samples.
-pub(crate) const DELAYS: [usize; 2] = [3, 8];
+const DELAYS: [usize; 2] = [3, 8];
 /// Samples between the drift's knots.
-pub(crate) const KNOT_EVERY: usize = 150;
+const KNOT_EVERY: usize = 150;
 /// A filter bank: first-order filters (time constants, samples) and pure delays (samples).
 #[derive(Debug, Clone, Copy)]
 pub struct Bank<'a> {
@@ -56,12 +56,12 @@ pub const BANK: Bank<'static> = Bank {
     delays: &DELAYS,
 };
 /// Order of the AR noise model.
-pub(crate) const AR_ORDER: usize = 4;
+const AR_ORDER: usize = 4;
 /// The smallest residual a fit reports, share of PV's sum of squares (the arithmetic's
 /// resolution: below it two fits are alike).
 const SSE_FLOOR: f64 = 1e-9;
 /// Fewest samples the test runs on.
-pub(crate) const MIN_SAMPLES: usize = 200;
+const MIN_SAMPLES: usize = 200;
 
 /// One record's PV, whitened, with its drift projected out.
 pub struct LevelsFit {

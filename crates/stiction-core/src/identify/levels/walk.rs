@@ -74,7 +74,7 @@ pub fn levels_walk(op: &[f64], pv: &[f64], integrating: bool) -> Option<LevelsWa
 
 /// Chunks the band's range is cut into (geometric), walked in parallel; the result is the
 /// sequential walk's, whatever the number of threads.
-pub(super) const WALK_CHUNKS: usize = 32;
+const WALK_CHUNKS: usize = 32;
 
 /// What one chunk's walk found: its best piece of a cell and that piece's error, its first and
 /// last pieces' errors (a cell that crosses the chunk's edge is walked in two pieces, one in each

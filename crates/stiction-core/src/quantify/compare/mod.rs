@@ -143,13 +143,13 @@ pub struct FitComparison {
 const PILOT_BANDS: [f64; 2] = [0.02, 0.1];
 /// Thornhill's regularity of the PV (trend removed) from which it limit-cycles: its lag is then
 /// read off the cycle and may fall short of the process's delay (see `Setup::new`).
-pub(super) const CYCLE_REGULARITY: f64 = 5.0;
+const CYCLE_REGULARITY: f64 = 5.0;
 /// Structures refined towards the output-error optimum per compared fit.
 const REFINED_STRUCTURES: usize = 3;
 /// Steiglitz-McBride iterations towards each compared fit's output-error optimum.
 const OE_ITERATIONS: usize = 4;
 /// The lag is this many times the process's response time (time constant and dead time) ...
-pub(super) const LAG_RESPONSES: f64 = 1.5;
+const LAG_RESPONSES: f64 = 1.5;
 /// ... at least `MIN_LAG` samples and at most this share of the record.
 const MIN_LAG: usize = 2;
 const MAX_LAG_SHARE: usize = 10;
@@ -160,7 +160,7 @@ pub fn max_lag(n: usize) -> usize {
 }
 
 /// An integrating process's changes are compared over at least this share of the record.
-pub(super) const INTEGRATING_LAG_SHARE: usize = 25;
+const INTEGRATING_LAG_SHARE: usize = 25;
 
 /// Compare the closed-loop fits with and without stiction. `None` when no linear model can be
 /// fitted (too few samples, OP or PV constant).

@@ -42,40 +42,40 @@ use serde::{Deserialize, Serialize};
 pub struct LimitCycle;
 
 /// Below this R² of the (low-passed) OP increments the controller is not a PI of the error.
-pub(crate) const MIN_PI_R2: f64 = 0.5;
+const MIN_PI_R2: f64 = 0.5;
 /// Above this share of OP's cycle unexplained by the PI, the recorded error does not drive OP.
-pub(crate) const MAX_CONTROLLER_RESIDUAL: f64 = 0.3;
+const MAX_CONTROLLER_RESIDUAL: f64 = 0.3;
 /// The valve lag the loop needs, degrees: stiction from `MIN_LAG` to `MAX_LAG` (a describing
 /// function of a valve lags by at most 90 degrees), full strength at `FULL_LAG`; below
 /// `LINEAR_LAG` the linear loop sustains the cycle by itself.
-pub(crate) const MIN_LAG: f64 = 25.0;
+const MIN_LAG: f64 = 25.0;
 /// The largest valve lag that counts as stiction, degrees (a valve's describing function lags by at
 /// most 90).
-pub(crate) const MAX_LAG: f64 = 90.0;
+const MAX_LAG: f64 = 90.0;
 /// The valve lag at which the stiction vote reaches full strength, degrees.
-pub(crate) const FULL_LAG: f64 = 50.0;
+const FULL_LAG: f64 = 50.0;
 /// Below this valve lag, degrees (and within `LINEAR_GAIN` of a gain of 1), the linear loop
 /// sustains the cycle by itself.
-pub(crate) const LINEAR_LAG: f64 = 10.0;
+const LINEAR_LAG: f64 = 10.0;
 /// ... and within this of a gain of 1.
-pub(crate) const LINEAR_GAIN: f64 = 0.15;
+const LINEAR_GAIN: f64 = 0.15;
 /// Largest distance between the needed describing function and a valve's.
-pub(crate) const MAX_DISTANCE: f64 = 0.2;
+const MAX_DISTANCE: f64 = 0.2;
 /// Largest share of the PV's cycle that OP may leave unexplained through the fitted process.
-pub(crate) const MAX_RESIDUAL: f64 = 0.35;
+const MAX_RESIDUAL: f64 = 0.35;
 /// The PV's measurement noise is taken off the unexplained share on cycles of at least this many
 /// samples (on shorter ones the cycle itself swells the noise estimate from PV's differences: at
 /// 12 samples a noise-free sinusoid passes for noise worth 0.07 of its cycle, at 8 samples 0.22).
-pub(crate) const NOISE_FREE_CYCLE: f64 = 12.0;
+const NOISE_FREE_CYCLE: f64 = 12.0;
 /// The identified linear loop's gain margin must exceed this. A little under 1 is allowed: a sticky
 /// valve's describing function has a gain under 1, so a loop unstable with a valve that follows OP
 /// can hold a cycle with a sticky one, and the closed-loop fit puts some of the valve's lag into
 /// the process. Set on the loop benchmark: at 0.8 no look-alike gains a loop vote there or in the
 /// plant benchmark's calibration sets, and the family votes stiction on 69 of the 240 sticky loops
 /// instead of 56 at 1.0.
-pub(crate) const MIN_MARGIN: f64 = 0.8;
+const MIN_MARGIN: f64 = 0.8;
 /// OP within this share of its range from either end counts as at a limit ...
-pub(crate) const LIMIT_NEAR: f64 = 0.01;
+const LIMIT_NEAR: f64 = 0.01;
 /// ... when this share of the cycles reach it.
 pub(crate) const LIMIT_CYCLES: f64 = 0.25;
 /// Strength of the vote against stiction when OP reaches a limit in [`LIMIT_CYCLES`] of the cycles.
@@ -83,15 +83,15 @@ pub(crate) const SATURATION_STRENGTH: f64 = 0.6;
 /// An amplitude that changes by this much over the record, or scatters this much from cycle to
 /// cycle (standard deviation of its logarithm), is reported as a linear loop's (not a vote: on
 /// plant data stick-slip cycles wander too).
-pub(crate) const UNSTEADY_CHANGE: f64 = 0.5;
+const UNSTEADY_CHANGE: f64 = 0.5;
 /// The scatter of the cycle amplitudes (standard deviation of their logarithm) at which the
 /// amplitude is reported as unsteady.
-pub(crate) const UNSTEADY_SCATTER: f64 = 0.25;
+const UNSTEADY_SCATTER: f64 = 0.25;
 /// A cycle sustains itself when its amplitude scatters less than this from cycle to cycle
 /// (standard deviation of its logarithm), changes by less than [`UNSTEADY_CHANGE`] over the record,
 /// and its phase wanders more than [`FREE_RUNNING`]. Set on the plant benchmark's calibration
 /// sets: no look-alike there holds its amplitude this well while its phase runs free.
-pub(crate) const STEADY_SCATTER: f64 = 0.15;
+const STEADY_SCATTER: f64 = 0.15;
 /// Over at least [`STEADY_CYCLES`] cycles a steady amplitude may scatter up to this. The scatter
 /// of a cycle that noise drives through a linear loop (its envelope Rayleigh-like: 0.64 in the
 /// long run) cannot come out this low by chance over so many cycles, and an envelope that swells
@@ -102,31 +102,31 @@ pub(crate) const STEADY_SCATTER: f64 = 0.15;
 /// were not called sticky lie between 0.15 and 0.25. Fast sticky loops called stiction there:
 /// 72.7 to 74.3 %; near-unstable loops called stiction 2.7 to 3.0 % (one loop); in the routine
 /// suite 3 sticky loops went from undetermined to stiction, nothing else changed.
-pub(crate) const STEADY_SCATTER_LONG: f64 = 0.25;
+const STEADY_SCATTER_LONG: f64 = 0.25;
 /// The cycles over which [`STEADY_SCATTER_LONG`] applies.
-pub(crate) const STEADY_CYCLES: usize = 30;
+const STEADY_CYCLES: usize = 30;
 /// The phase wander (`Cycles::phase_wander`) above which the cycle keeps no outside clock: a cycle
 /// forced by an input of fixed period stays under 2 in 99 of 100 records of 6 to 60 cycles (under
 /// 2.6 in 999 of 1,000). On the plant benchmark's steady cycles (both sets, both suites) no
 /// look-alike exceeds 1.5, and 42 of 53 sticky fast loops exceed 2.
-pub(crate) const FREE_RUNNING: f64 = 2.0;
+const FREE_RUNNING: f64 = 2.0;
 /// The strength of a stiction vote from a self-sustained cycle (with a setpoint recorded; without
 /// one the family does not vote on it: an outer loop's cycle moving the setpoint looks the same).
-pub(crate) const SELF_SUSTAINED: f64 = 0.6;
+const SELF_SUSTAINED: f64 = 0.6;
 /// A predicted period within this factor of the observed one matches it.
-pub(crate) const PERIOD_MATCH: f64 = 1.25;
+const PERIOD_MATCH: f64 = 1.25;
 /// The harmonics are measured up to the 5th, or as many as lie below the Nyquist frequency; under
 /// this many (the 3rd, where a symmetric valve cycle puts most of its distortion) they are not
 /// measured and not asked for.
-pub(crate) const MIN_HARMONICS: usize = 3;
+pub(super) const MIN_HARMONICS: usize = 3;
 /// The controller is identified below this many times the cycle's frequency.
-pub(crate) const PI_CUTOFF: f64 = 4.0;
+const PI_CUTOFF: f64 = 4.0;
 /// Without a setpoint the stiction vote's strength is multiplied by this (a cascade's moving
 /// setpoint cannot be ruled out).
-pub(crate) const NO_SETPOINT: f64 = 0.6;
+const NO_SETPOINT: f64 = 0.6;
 
 /// How the thresholds were set, reported with every result.
-pub(crate) const CALIBRATION: &str = "thresholds set on simulated fast loops (sticky valves of Stenman, Kano and He bands; healthy valves with \
+const CALIBRATION: &str = "thresholds set on simulated fast loops (sticky valves of Stenman, Kano and He bands; healthy valves with \
 an external sinusoid or narrow-band disturbance, aggressive tuning, saturation, a cascade's moving setpoint; \
 examples/loop_benchmark.rs, docs/loop-benchmark.md), not on the data judged";
 

@@ -51,11 +51,11 @@ pub(crate) const CYCLE_CANCELLED_STICTION: f64 = SIGNIFICANCE_STICTION;
 pub(crate) const FORCED_REGULARITY: f64 = 100.0;
 /// ... measured over at least this many zero crossings of the autocorrelation (two periods: a
 /// regularity from fewer measures no spread).
-pub(crate) const FORCED_CROSSINGS: usize = crate::detect::SPREAD_CROSSINGS;
+pub(super) const FORCED_CROSSINGS: usize = crate::detect::SPREAD_CROSSINGS;
 /// ... and the band's gain over the linear loop at least this share of the PV's variation above
 /// its noise (a band that reshapes the fit of so regular a cycle by a twentieth of it; the
 /// externally oscillating loops gain 7.8 % and more).
-pub(crate) const FORCED_GAIN: f64 = 0.05;
+pub(super) const FORCED_GAIN: f64 = 0.05;
 
 /// Whether the cycle keeps time like an input of fixed period ([`FORCED_REGULARITY`]).
 pub(super) fn clock_regular(ctx: &Context) -> bool {

@@ -31,7 +31,7 @@ use serde::{Deserialize, Serialize};
 /// The fitted valve's PV must carry at least this share of its cycle's power in harmonics 2 to
 /// 5 (the shape family's bound of a sinusoid): a fit whose PV is itself sinusoidal has no shape
 /// to miss.
-pub(crate) const FIT_HARMONICS: f64 = SINUSOIDAL_HARMONICS;
+pub(super) const FIT_HARMONICS: f64 = SINUSOIDAL_HARMONICS;
 /// ... and this many times those of the recorded PV: above every sticky valve of the
 /// catalogue's calibration draws (the largest 4.5).
 pub(crate) const FOREIGN_SHAPE: f64 = 5.0;

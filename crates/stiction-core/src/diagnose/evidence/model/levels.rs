@@ -34,9 +34,9 @@ use serde::{Deserialize, Serialize};
 /// The levels test's ratio at and above which it votes stiction.
 pub(crate) const LEVELS_STICTION: f64 = 50.0;
 /// The ratio at which its vote is held with full strength.
-pub(crate) const LEVELS_DECISIVE: f64 = 500.0;
+const LEVELS_DECISIVE: f64 = 500.0;
 /// Above this share of PV samples not recorded the test is not run.
-pub(crate) const MAX_UNRECORDED: f64 = 0.2;
+const MAX_UNRECORDED: f64 = 0.2;
 
 /// What the levels test found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -33,9 +33,11 @@ mod withdraw;
 pub(crate) use bound::{compared, BOUND_LAG_DIVISOR};
 use cycle::clock_regular;
 pub use cycle::CycleCancelled;
-pub(crate) use cycle::{CYCLE_CANCELLED_STICTION, FORCED_GAIN, FORCED_REGULARITY};
+use cycle::FORCED_GAIN;
+pub(crate) use cycle::{CYCLE_CANCELLED_STICTION, FORCED_REGULARITY};
 pub use cycle_shape::CycleShape;
-pub(crate) use cycle_shape::{FIT_HARMONICS, FOREIGN_SHAPE};
+use cycle_shape::FIT_HARMONICS;
+pub(crate) use cycle_shape::FOREIGN_SHAPE;
 pub use figures::ModelEvidence;
 use figures::{fits_words, model_evidence, threshold_words};
 pub use levels::LevelsEvidence;
@@ -63,7 +65,7 @@ pub struct Model;
 /// controller or follows OP's unprovoked steps, and such votes are withdrawn (`withdraw.rs`).
 pub(crate) const SIGNIFICANCE_STICTION: f64 = 50.0;
 /// The ratio at which a stiction vote is held with full strength.
-pub(crate) const SIGNIFICANCE_DECISIVE: f64 = 500.0;
+const SIGNIFICANCE_DECISIVE: f64 = 500.0;
 /// At and below this ratio the fit votes against stiction (weakly: a sticky valve whose effect a
 /// linear loop mimics, or whose record is too short or noisy, gives it too). About the 85th
 /// percentile of the healthy routine loops of the calibration set.
@@ -112,7 +114,7 @@ const ELSEWHERE_STRENGTH: f64 = 0.9;
 /// little (levels and temperatures above all), and the vote is weak
 /// (`ELSEWHERE_WEAK_STRENGTH`). On the catalogue's calibration sets (routine and fast) 20 of the
 /// 21 loops under 0.15 have a healthy valve, 10 of the 17 between 0.15 and 0.3.
-pub(crate) const ELSEWHERE_CLEAR: f64 = 0.15;
+const ELSEWHERE_CLEAR: f64 = 0.15;
 /// Strength of the vote against stiction when OP explains between [`ELSEWHERE_CLEAR`] and
 /// [`MIN_EXPLAINED`]: just over the verdict's weak dissent, so it still keeps a lone vote for
 /// stiction from deciding (every verdict of the plant benchmark stays as it was), while a
@@ -121,7 +123,7 @@ pub(crate) const ELSEWHERE_CLEAR: f64 = 0.15;
 /// routine windows and 88 % on the benchmark set's; with the vote graded, 95 % on both.
 const ELSEWHERE_WEAK_STRENGTH: f64 = 0.55;
 /// Fewest changes over the lag that do not overlap (samples over the lag) for the test.
-pub(crate) const MIN_INDEPENDENT: f64 = 8.0;
+const MIN_INDEPENDENT: f64 = 8.0;
 /// Below this share of the PV's variance above its noise the record carries too little signal. The
 /// noise is PV's fast changes, but no more than the best fit leaves: on the plant benchmark's
 /// calibration set, 27 of the 540 routine windows whose fits explain 5 to 96 % of PV's changes
@@ -129,10 +131,10 @@ pub(crate) const MIN_INDEPENDENT: f64 = 8.0;
 /// 10 s, pass for noise); 7 not-sticky ones among them were left `insufficient_data` or
 /// `undetermined` and are now `no_stiction`; of the sticky ones, one is now `stiction`, one
 /// `no_stiction`; of the backlash valves, one `stiction`, two `no_stiction`.
-pub(crate) const MIN_SIGNAL_SHARE: f64 = 0.05;
+const MIN_SIGNAL_SHARE: f64 = 0.05;
 
 /// How the thresholds were set, reported with every result.
-pub(crate) const CALIBRATION: &str = "test ratio calibrated on simulated healthy and sticky loops of many kinds (flow, pressure, level, \
+const CALIBRATION: &str = "test ratio calibrated on simulated healthy and sticky loops of many kinds (flow, pressure, level, \
 temperature; setpoint steps, load drifts, ramps, disturbances, three noise levels; the catalogue's calibration set, other seeds \
 than the benchmark's), not on the data judged";
 

@@ -19,7 +19,7 @@ pub(crate) const STEP_SIGMAS: f64 = 6.0;
 /// ... with the control error inside this many of PV's noise standard deviations at the step and
 /// at every sample since OP's previous move (one sample before it where OP moves every sample; a
 /// controller slower than the record acts on every error since it last ran).
-pub(crate) const QUIET_SIGMAS: f64 = 3.0;
+const QUIET_SIGMAS: f64 = 3.0;
 /// The share of OP's travel in unprovoked steps from which the model family's stiction vote is
 /// withdrawn. On the catalogue's calibration sets (`plant_benchmark --calibration --jsonl`) no
 /// sticky loop has a single unprovoked step (routine windows and fast loops; nor on the benchmark
@@ -27,7 +27,7 @@ pub(crate) const QUIET_SIGMAS: f64 = 3.0;
 /// and 0.097 of OP's travel) and two quantised PVs' (0.012 and 0.029). On the benchmark set it
 /// withdrew three fed-forward loads' (0.010, 0.029, 0.087), a quantised PV's (0.012) and a load
 /// step's (0.014), and no sticky loop's verdict moved.
-pub(crate) const MAX_UNPROVOKED_SHARE: f64 = 0.01;
+const MAX_UNPROVOKED_SHARE: f64 = 0.01;
 
 /// OP's unprovoked steps on the analysed stretch.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -32,7 +32,7 @@ pub struct Settings<'a> {
 
 /// The slip must move the judged signal by at least this share of what the OP travel would
 /// give through the process gain ...
-pub(crate) const SLIP_SHARE: f64 = 0.3;
+const SLIP_SHARE: f64 = 0.3;
 
 /// Find the stick-slip episodes of a record: `pv` is the signal judged, with `s.pv_noise` its
 /// noise.

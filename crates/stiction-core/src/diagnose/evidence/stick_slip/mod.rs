@@ -33,21 +33,21 @@ const STICTION_STRENGTH: f64 = 0.4;
 /// not-sticky loop with 20 episodes or more spends more than 66 % of the OP's travel in them (the
 /// highest: an equal-percentage valve, 66 %, a saturating OP, 64 %, an external oscillation,
 /// 62 %); 36 sticky loops and 1 backlash valve reach 20 episodes holding 70 % or more.
-pub(crate) const DECISIVE_EPISODES: usize = 20;
+const DECISIVE_EPISODES: usize = 20;
 /// See [`DECISIVE_EPISODES`].
-pub(crate) const DECISIVE_SHARE: f64 = 0.7;
+const DECISIVE_SHARE: f64 = 0.7;
 /// Strength of a stiction vote from [`DECISIVE_EPISODES`] episodes: above the verdict's need.
 const DECISIVE_STRENGTH: f64 = 0.6;
 /// Episodes at and above which the family votes stiction ...
 pub(crate) const MIN_EPISODES: usize = 5;
 /// ... when at least this share of the OP's travel was spent stuck.
-pub(crate) const MIN_STUCK_SHARE: f64 = 0.5;
+const MIN_STUCK_SHARE: f64 = 0.5;
 /// At most this many episodes, with at least this share of OP travel ...
-pub(crate) const MAX_EPISODES_NONE: usize = 1;
+const MAX_EPISODES_NONE: usize = 1;
 /// ... over at least this many quiet stretches, vote against stiction ...
-pub(crate) const MIN_STRETCHES_NONE: usize = 10;
+const MIN_STRETCHES_NONE: usize = 10;
 /// ... in a record of at least this many samples (a short record shows few sticks either way).
-pub(crate) const MIN_SAMPLES_NONE: usize = 400;
+const MIN_SAMPLES_NONE: usize = 400;
 
 /// What the episodes show.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
