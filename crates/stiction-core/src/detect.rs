@@ -112,7 +112,7 @@ pub fn measurement_noise(x: &[f64]) -> f64 {
 const HELD_SHARE: f64 = 0.3;
 
 /// The noise of a signal that may be held between updates (OP recorded faster than the
-/// controller runs): [`measurement_noise`], except that where at least [`HELD_SHARE`] of the
+/// controller runs): [`measurement_noise`], except that where at least `HELD_SHARE` of the
 /// first differences are exactly zero it is taken from the changes between the held values alone
 /// (a held signal's median change is zero, which would call it noise-free).
 pub fn held_noise(x: &[f64]) -> f64 {

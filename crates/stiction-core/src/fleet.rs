@@ -217,8 +217,8 @@ const SAME_PERIOD: f64 = 0.10;
 /// A loop's cycle counts from this regularity (Thornhill's: over 1, a regular oscillation).
 const REGULAR: f64 = 1.0;
 
-/// For each row, how many other rows oscillate at its period ([`SAME_PERIOD`]; both regular,
-/// [`REGULAR`]); 0 for a row that does not oscillate. Where several loops of one unit share a
+/// For each row, how many other rows oscillate at its period (`SAME_PERIOD`; both regular,
+/// `REGULAR`); 0 for a row that does not oscillate. Where several loops of one unit share a
 /// period, one of them may drive the others: a stiction verdict on a loop that shares its period
 /// is read with that in mind (stiction-lab/results/propagated-oscillation.md). Loops from different units or
 /// time windows can share a period by chance.

@@ -329,8 +329,8 @@ const SPIKE_RANGES: f64 = 3.0;
 /// it is (they are its own behaviour, not glitches) and none is marked.
 const SPIKE_SHARE: f64 = 0.01;
 
-/// The samples of `x` that are spikes: runs of at most [`SPIKE_RUN`] samples beyond the
-/// signal's 1st to 99th percentile range by more than [`SPIKE_RANGES`] times that range, with
+/// The samples of `x` that are spikes: runs of at most `SPIKE_RUN` samples beyond the
+/// signal's 1st to 99th percentile range by more than `SPIKE_RANGES` times that range, with
 /// the samples either side back inside it. A single historian glitch (a PV of 1e6 in a loop
 /// that runs between 48 and 52) otherwise dominates every fit and index. Non-finite samples are
 /// not spikes (they are missing); none when the signal has no spread or spikes are not rare.

@@ -22,7 +22,7 @@ const GROWTH_LIMIT: f64 = 2.0;
 pub enum Stability {
     /// The error does not grow.
     Stable,
-    /// The error's RMS grows by more than [`GROWTH_LIMIT`] from the second to the last quarter:
+    /// The error's RMS grows by more than `GROWTH_LIMIT` from the second to the last quarter:
     /// a growing oscillation or a PV drifting away.
     Growing,
     /// The PV is no longer a finite number of sensible size (beyond 1e6).

@@ -2,7 +2,7 @@
 //! noise on to OP; a band of a few of OP's noise standard deviations is crossed by the noise alone,
 //! and the valve then moves in small jumps that look like a healthy valve's noise. On the
 //! catalogue's simulated sticky valves the families found few of the bands under [`SMALL`] OP
-//! noise standard deviations and most of those over [`LARGE`] (`stiction-lab/results/plant-benchmark.md`, the
+//! noise standard deviations and most of those over `LARGE` (`stiction-lab/results/plant-benchmark.md`, the
 //! table by band over the OP's noise), so a `no_stiction` verdict speaks for large bands and is
 //! nearly silent on small ones.
 
@@ -33,7 +33,7 @@ pub struct Reach {
     /// Bands under this (% of span; [`SMALL`] OP noise standard deviations) were found in
     /// `found_small` of simulated records.
     pub small_band_percent_of_span: f64,
-    /// Bands over this (% of span; [`LARGE`] OP noise standard deviations) were found in
+    /// Bands over this (% of span; `LARGE` OP noise standard deviations) were found in
     /// `found_large` of simulated records.
     pub large_band_percent_of_span: f64,
     /// The lowest and highest share of simulated sticky valves with a small band called

@@ -2,7 +2,7 @@
 //! data.
 //!
 //! The recursion is sequential in time but independent across candidates, so candidates are taken
-//! in groups of [`LANES`]: one pass over the samples advances every member of the group (the inner
+//! in groups of `LANES`: one pass over the samples advances every member of the group (the inner
 //! loop over the group is what the compiler vectorises). Nothing here allocates. Large batches are
 //! spread over threads by group; each candidate's sum is computed in the same order whatever the
 //! thread count, so results never depend on it.

@@ -143,7 +143,7 @@ fn ratio_grid() -> impl Iterator<Item = f64> {
 }
 
 /// The describing functions of the valves a band can be: Kano's (closed form) for each of
-/// [`SLIP_RATIOS`], and Stenman's sampled `samples_per_period` times a period (its staircase).
+/// `SLIP_RATIOS`, and Stenman's sampled `samples_per_period` times a period (its staircase).
 pub fn valve_loci(samples_per_period: f64) -> Vec<ValveLocus> {
     let mut out: Vec<ValveLocus> = SLIP_RATIOS
         .iter()

@@ -34,9 +34,9 @@ pub fn longest_clean(columns: &[&[f64]]) -> Option<(usize, usize)> {
 }
 
 /// The runs of rows `[start, end)` with a missing value in some column that can be bridged: at
-/// most [`BRIDGE_MAX_RUN`] rows, a present row on either side, and `joinable` true from the row
+/// most `BRIDGE_MAX_RUN` rows, a present row on either side, and `joinable` true from the row
 /// before to the row after (no break of the time axis, no manual mode, as the caller judges).
-/// Empty when there is none, or when they would hold more than [`BRIDGE_MAX_SHARE`] of the rows.
+/// Empty when there is none, or when they would hold more than `BRIDGE_MAX_SHARE` of the rows.
 pub fn short_gaps(columns: &[&[f64]], joinable: &dyn Fn(usize) -> bool) -> Vec<(usize, usize)> {
     let n = columns.iter().map(|c| c.len()).min().unwrap_or(0);
     let missing = |k: usize| columns.iter().any(|c| !c[k].is_finite());

@@ -206,7 +206,7 @@ pub(super) fn robust_mean_std(v: &mut [f64]) -> (f64, f64) {
 /// - TNLI = Σ significant bic² (total non-linearity index), a measure of how much
 ///   non-linearity there is.
 ///
-/// A record too short for [`MIN_SEGMENTS`] segments of `segment_length` samples is retried with
+/// A record too short for `MIN_SEGMENTS` segments of `segment_length` samples is retried with
 /// 64-sample segments; `None` if it is still too short, if `segment_length < 16`, if the signal
 /// holds non-finite values or is constant.
 ///

@@ -1,6 +1,6 @@
 //! The statistics the combination reads: what the families measured, as numbers, in one order.
 //! Each is taken as the families report it (a missing one reads 0, a shape index not computed
-//! [`NOT_COMPUTED`]); counts, ratios and spans that run over decades are read on a signed log
+//! `NOT_COMPUTED`); counts, ratios and spans that run over decades are read on a signed log
 //! scale.
 
 use crate::diagnose::evidence::{Family, FamilyEvidence};
@@ -34,7 +34,7 @@ pub enum Scale {
     Ln,
     /// A family's vote: +1 stiction, -1 none, 0 undetermined.
     Vote,
-    /// A shape index's value as it is, [`NOT_COMPUTED`] where it could not be computed.
+    /// A shape index's value as it is, `NOT_COMPUTED` where it could not be computed.
     Index,
 }
 
@@ -242,7 +242,7 @@ fn vote(families: &[FamilyEvidence], f: Family) -> f64 {
     family(families, f).map_or(0.0, |e| e.vote.sign())
 }
 
-/// The statistics of one judged stretch, in [`NAMES`]' order (every one finite).
+/// The statistics of one judged stretch, in `NAMES`' order (every one finite).
 pub fn of(s: &Stretch) -> [f64; COUNT] {
     let fams = s.families;
     let model = family(fams, Family::Model).and_then(|f| f.model.as_ref());

@@ -1,7 +1,7 @@
 //! The families' statistics read together: gradient-boosted trees, trained on simulated loops
 //! of many kinds (the catalogue's calibration draws, routine and fast; never the ISDB), give the
 //! probability of a sticky valve from the 45 statistics the families report
-//! ([`features::NAMES`]). The verdict's rules read each family's vote and a few of its figures;
+//! (`features::NAMES`). The verdict's rules read each family's vote and a few of its figures;
 //! the trees also read how the figures go together (a closed-loop fit's test ratio between its
 //! thresholds while the stick-slip episodes and the oscillation's amplitude say more), which
 //! finds sticky valves the rules leave `no_stiction` or `undetermined`.
@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 /// One statistic as the trees read it, and how much it moved their log-odds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Statistic {
-    /// Its name ([`features::NAMES`]).
+    /// Its name (`features::NAMES`).
     pub name: String,
     /// Its value as the trees read it (log-scaled ones on their log scale).
     pub value: f64,

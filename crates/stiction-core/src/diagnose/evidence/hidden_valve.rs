@@ -82,7 +82,7 @@ pub struct HiddenValveEvidence {
     /// on OP; else He's, with `fd` this).
     pub short_percent_of_span: f64,
     /// The ratio of each draw of the particle filter's noise, in the order of their seeds: one
-    /// when the first is under the threshold, else [`DRAWS`], whose median is `ratio`.
+    /// when the first is under the threshold, else `DRAWS`, whose median is `ratio`.
     pub draws: Vec<f64>,
     /// Particles of the sticky hypothesis's filter.
     pub particles: usize,

@@ -164,7 +164,7 @@ pub struct Context<'a> {
     /// The closed-loop fits with and without stiction (`None` when no linear model fits).
     pub fits: Option<FitComparison>,
     /// The lag's bound, when the fits' lag reached it and the comparison over a third of it was
-    /// kept ([`model::BOUND_LAG_DIVISOR`]).
+    /// kept (`model::BOUND_LAG_DIVISOR`).
     pub lag_bound: Option<usize>,
     /// The shape family's indices, once computed (they go to [`super::Diagnosis::indices`]).
     pub indices: std::cell::OnceCell<Vec<super::result::Index>>,

@@ -2,13 +2,13 @@
 //!
 //! PV is regressed by least squares on a bank of first-order filters of the valve position (each
 //! delayed a sample) and two pure delays, for a level loop also the valve's running sum, beside a
-//! piecewise-linear drift (a knot every [`KNOT_EVERY`] samples). The regressors hold only valve
+//! piecewise-linear drift (a knot every `KNOT_EVERY` samples). The regressors hold only valve
 //! positions from before each PV sample and the drift is smooth, so PV's measurement noise, which
 //! the controller feeds back into OP at once, cannot favour OP, and the fit has no PV past among
 //! its regressors (an ARX fit's bias towards the valve that follows OP).
 //!
 //! The residual is not white (load drift between the knots, an external cycle), so the fit is a
-//! generalised least squares: an AR noise model of order [`AR_ORDER`], estimated on the residual
+//! generalised least squares: an AR noise model of order `AR_ORDER`, estimated on the residual
 //! with OP, whitens PV and every column. The log-likelihood ratio
 //! `n/2 ln(SSE with OP / SSE with the valve)` then counts a coloured residual as fewer independent
 //! samples, and an external cycle or a slow drift no longer passes for the valve.

@@ -194,7 +194,7 @@ pub struct LoopEvidence {
     /// Mean amplitude of PV's fundamental per cycle, PV units.
     pub pv_amplitude: f64,
     /// Harmonic distortion of the cycle (the larger of OP's and PV's; harmonics 2 to
-    /// `harmonic_count` over the fundamental's power). `None` when fewer than [`MIN_HARMONICS`]
+    /// `harmonic_count` over the fundamental's power). `None` when fewer than `MIN_HARMONICS`
     /// lie below the Nyquist frequency: a cycle of under 7 samples cannot show a valve's jumps, and
     /// the family then does not ask for them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -207,7 +207,7 @@ pub struct LoopEvidence {
     pub harmonic_count: usize,
     /// Share of the PV's cycle (RMS over the cycles of its fundamental) that OP does not explain
     /// through the fitted process, above what PV's measurement noise puts there (on cycles of at
-    /// least [`NOISE_FREE_CYCLE`] samples).
+    /// least `NOISE_FREE_CYCLE` samples).
     pub residual_share: f64,
     /// Share of OP's cycle that the identified PI does not explain from the error's cycle (a
     /// setpoint moving unrecorded, or a controller that is not a PI).
@@ -238,13 +238,13 @@ pub struct LoopEvidence {
     /// Caveats (a missing setpoint, a cascade).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub caveat: Option<String>,
-    /// How the thresholds were set ([`CALIBRATION`]).
+    /// How the thresholds were set (`CALIBRATION`).
     pub calibration: String,
 }
 
 impl LoopEvidence {
     /// Whether the identified linear loop sustains the cycle by itself: it needs no valve lag
-    /// (under [`LINEAR_LAG`]) and a gain within [`LINEAR_GAIN`] of 1, i.e. it sits at its
+    /// (under `LINEAR_LAG`) and a gain within `LINEAR_GAIN` of 1, i.e. it sits at its
     /// stability limit at the cycle's period (aggressive tuning, or a band small beside the cycle).
     pub fn linear_loop_sustains(&self) -> bool {
         self.needed_lag_degrees.abs() < LINEAR_LAG && (self.needed_gain - 1.0).abs() < LINEAR_GAIN

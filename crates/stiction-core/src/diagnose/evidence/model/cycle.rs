@@ -79,7 +79,7 @@ pub struct CycleCancelled {
     /// The improvement of the fit with stiction, share of the changes' variance above the noise.
     pub improvement: f64,
     /// The calibrated test's ratio (as the family's first comparison's); stiction at
-    /// [`CYCLE_CANCELLED_STICTION`].
+    /// `CYCLE_CANCELLED_STICTION`.
     pub significance: f64,
     /// Share of the changes' variance above the noise explained with stiction.
     pub explained: f64,

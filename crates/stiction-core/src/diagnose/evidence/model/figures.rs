@@ -80,7 +80,7 @@ pub struct ModelEvidence {
     pub sse_stiction: f64,
     /// The measurement noise's expected sum of squares over the samples compared.
     pub sse_noise: f64,
-    /// How the test ratio was calibrated ([`CALIBRATION`]).
+    /// How the test ratio was calibrated (`CALIBRATION`).
     pub calibration: String,
     /// The levels test, when the request is `thorough` and it ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -91,15 +91,15 @@ pub struct ModelEvidence {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle_cancelled: Option<CycleCancelled>,
     /// The stiction vote was withdrawn: the band's gain lay in a cycle that keeps time like an
-    /// input of fixed period, and over whole periods it gained nothing ([`super::FORCED_REGULARITY`]).
+    /// input of fixed period, and over whole periods it gained nothing (`super::FORCED_REGULARITY`).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub gain_in_a_clock_regular_cycle: bool,
     /// The stiction vote was withdrawn: the fitted process and the identified PI make a loop
-    /// gain under [`super::MIN_LOOP_GAIN`], so the fit explains PV through the controller's own law.
+    /// gain under `super::MIN_LOOP_GAIN`, so the fit explains PV through the controller's own law.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub fit_mirrors_controller: bool,
     /// The stiction vote was withdrawn: OP steps that the control error did not provoke carry
-    /// [`super::MAX_UNPROVOKED_SHARE`] or more of OP's travel (a feed-forward, an override, an operator).
+    /// `MAX_UNPROVOKED_SHARE` or more of OP's travel (a feed-forward, an override, an operator).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub op_moved_elsewhere: bool,
     /// On a regular cycle where the fit voted stiction, the harmonics of the cycle in the PV the
@@ -108,7 +108,7 @@ pub struct ModelEvidence {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle_shape: Option<CycleShape>,
     /// The lag's bound (samples), when the lag reached it and the comparison over a third of it
-    /// ([`super::BOUND_LAG_DIVISOR`]), which `lag` then gives, had the higher test ratio.
+    /// (`super::BOUND_LAG_DIVISOR`), which `lag` then gives, had the higher test ratio.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lag_bound: Option<usize>,
 }
