@@ -263,7 +263,7 @@ pub(super) fn size(
         d.warnings.push(format!(
             "the stiction verdict rests on a cycle that sustains itself in a loop that needs no valve lag (near its stability limit): there the \
              describing function cannot size the band and a fit reads sticks shorter than a sample as no stick, so the band ({:.2} % of span, {}) is \
-             rough and may understate it (on such loops of the loop benchmark the band reported was a median 0.44 of the simulated one); a valve travel test sizes it",
+             rough and may understate it (on such simulated loops it fell well short of the true band); a valve travel test sizes it",
             band.band_percent_of_span,
             band.source.words()
         ));

@@ -29,8 +29,8 @@ pub(super) fn next_step(
     match motion.pv_not_recorded {
         Some(share) if matches!(verdict, Verdict::NoStiction | Verdict::Undetermined) => format!(
             "{step}; but PV is not recorded in {:.0} % of the samples (historian compression or a frozen transmitter), \
-             and compression hides a sticky valve's sticks (of simulated sticky valves recorded through it, 42 % were \
-             called stiction against 66 % stored whole): judge a record stored without compression before ruling the valve out",
+             and compression hides a sticky valve's sticks (simulated sticky valves recorded through it are found far less \
+             often than stored whole): judge a record stored without compression before ruling the valve out",
             100.0 * share
         ),
         _ => step,
