@@ -4,11 +4,9 @@
 //! balance differs from that by more than [`CROSS_CHECK`] (then it is reported), else the
 //! closed-loop fit's slip-jump band when it is larger by more than [`SLIP_JUMP_CHECK`]; the
 //! stick-slip episodes' median OP travel, the other estimates and the ellipse of an oscillation
-//! are given beside it. Where the hidden-valve family decided the verdict (`thorough`), its band
-//! is reported: measured with `plant_benchmark --thorough --jsonl` on the sticky loops it
-//! decided, within 1.5x of the simulated band in 9 of 14 (calibration set) and 9 of 11
-//! (benchmark set, judged after); measured when the hidden valve was Stenman's alone, its band
-//! in 9 of 13 and 7 of 9, the band the other sources gave in 4 of 13 and 4 of 9.
+//! are given beside it. Where the hidden-valve family decided the verdict (`thorough`), its band is
+//! reported: on the sticky loops it decides it is nearer the simulated band than the other sources'
+//! (`plant_benchmark --thorough`).
 
 use super::evidence::limit_cycle::StictionBasis;
 use super::evidence::Family;
@@ -23,50 +21,34 @@ use crate::spectral;
 /// Estimates that differ by more than this factor get a warning.
 const DISAGREE: f64 = 2.0;
 
-/// Where the loop family explains a limit cycle, its describing function's band and the
-/// closed-loop fit's are two independent estimates. When they differ by more than this factor, the
-/// describing function's is reported (it needs no single stick resolved; the closed-loop fit reads
-/// sticks shorter than a sample, a valve's lag or a controller faster than the record as no stick).
-/// Measured on the plant benchmark's sticky loops the loop family called sticky (`plant_benchmark
-/// --jsonl`, band over the simulated band): the closed-loop estimate was within 1.5x of the truth in
-/// 5 of 19 / 7 of 21 routine loops (calibration / benchmark set) and 12 of 28 / 10 of 27 fast ones,
-/// the describing function's in 17 / 17 and 24 / 24, and this rule's in 17 / 16 and 23 / 19. On 54
-/// idealised loops (`stiction simulate --loop closed` with `diagnose_benchmark`'s processes, d = 1,
-/// 2 or 4, seeds 1-6), where the closed-loop estimate is exact, 32 have a describing-function band
-/// and the rule keeps the exact estimate in 29 (the 3 others: d = 4, bands of 1.7 to 2.2).
+/// Where the loop family explains a limit cycle, its describing function's band and the closed-loop
+/// fit's are two independent estimates; when they differ by more than this factor the describing
+/// function's is reported. It needs no single stick resolved, where the fit reads sticks shorter
+/// than a sample, a valve's lag or a controller faster than the record as no stick (on the sticky
+/// loops the loop family calls sticky it is the nearer of the two; where the closed-loop estimate
+/// is exact, the rule mostly keeps it).
 const CROSS_CHECK: f64 = 1.5;
 
 /// The closed-loop fit also fits Kano's valve, its slip jump `J` free beside the band `S`. A
 /// Stenman fit, bound to jump all the way back to OP, often settles on a small band near OP
-/// (stiction-lab/results/sampled-valve.md: the knife-edge partition, a controller moving OP between samples); the
-/// slip-jump valve's `S` less so. Where the describing function has not replaced the Stenman band
-/// and `S` is larger than it by more than this factor, `S` is reported, the Stenman band beside
-/// it. Measured on the catalogue's calibration draws (`plant_benchmark --extra`, the calibration
-/// set and draws 1-9; the sticky loops called `stiction`, band over the simulated Stenman `d`,
-/// Kano `S` or He `fs`): within 1.5x of the truth in 49 % of 1,130 routine loops before the rule,
-/// 72 % with it, within 2x in 69 % and 86 %; in 59 % and 71 % of 641 fast loops (74 % and 83 %
-/// within 2x). At a factor of 1 the same; at 1.5, 66 % of the routine loops. Both estimates err low
-/// far more often than high: the larger one corrects the common error. The describing function
-/// checked against the slip-jump band instead of the Stenman band gives 71 % and 68 %.
+/// (stiction-lab/results/sampled-valve.md: the knife-edge partition, a controller moving OP between
+/// samples); the slip-jump valve's `S` less so. Where the describing function has not replaced the
+/// Stenman band and `S` is larger than it by more than this factor, `S` is reported, the Stenman
+/// band beside it: both err low far more often than high, so the larger one corrects the common
+/// error.
 const SLIP_JUMP_CHECK: f64 = 1.2;
 
 /// A band from the fits under this many of the OP's noise standard deviations is no band they
 /// resolve: a valve whose band the OP's noise crosses at most samples moves with OP, and the fits
 /// cannot tell it from one that follows OP. The oscillation's ellipse is reported then, or else the
-/// stick-slip episodes' median OP travel. Measured on the catalogue's calibration draws (the
-/// calibration set and draws 1-9; the sticky loops called `stiction`): 77 of the 1,806 bands lay
-/// under twice the OP's noise; 10 of them within 1.5x of the simulated band, 40 of their
-/// ellipses. Within 1.5x overall: routine loops 72.4 to 73.9 %, fast loops 71.6 to 73.7 % (at
-/// once the noise: 73.4 and 72.9 %; at three times: 74.4 and 74.5 %).
+/// stick-slip episodes' median OP travel (the ellipse is then the nearer of the two to the
+/// simulated band).
 const UNRESOLVED_NOISES: f64 = 2.0;
 
 /// Where the levels test (`thorough`) voted stiction, its band and the closed-loop estimate's are
-/// two estimates; when they differ by more than this factor the levels test's is reported. The
-/// fit of PV's changes often settles on a small band near OP where the levels test finds the
-/// valve (stiction-lab/results/sampled-valve.md). Measured with `plant_benchmark --thorough --jsonl` on the sticky
-/// loops called `stiction` whose levels ratio reached the threshold (band within 1.5x of the
-/// simulated band): the verdict's band before the rule in 58 of 92 (calibration set) and 65 of 93
-/// (benchmark set), the levels test's in 56 and 63, this rule's in 61 and 70.
+/// two estimates; when they differ by more than this factor the levels test's is reported. The fit
+/// of PV's changes often settles on a small band near OP where the levels test finds the valve
+/// (stiction-lab/results/sampled-valve.md).
 const LEVELS_CHECK: f64 = 1.5;
 
 /// The band's other estimates (OP units), from the families and the oscillation.

@@ -164,13 +164,9 @@ pub fn polish_output_error(data: &Data, mv: &[f64], start: &Fit) -> Option<Fit> 
 
 /// Levenberg-Marquardt iterations on the simulation error after Steiglitz-McBride.
 const LM_ITERATIONS: usize = 12;
-/// ... stopped after a step that lowers the error by at most this share of it. Measured on the
-/// plant benchmark's four sets (`plant_benchmark --jsonl`, routine and fast, calibration and
-/// benchmark, 1,560 loops): at a millionth no verdict moves and 41 bands move a little (none
-/// across the 1.5x mark of the simulated band), the batch's CPU time falls by about 4 %;
-/// at a hundred-thousandth 3 verdicts move, at a ten-thousandth 8. On the nine further
-/// calibration draws (7,020 loops, `--spread 9`) a millionth moved 2: a healthy routine loop from
-/// `no_stiction` to `undetermined`, one more sticky fast loop found.
+/// ... stopped after a step that lowers the error by at most this share of it: at a millionth the
+/// plant benchmark's verdicts stay and its bands move a little, for about 4 % less CPU time in a
+/// batch.
 const LM_TOLERANCE: f64 = 1e-6;
 
 /// The forward-difference Jacobian of a fit's simulation errors on `mv` (structure `s`): each

@@ -27,15 +27,8 @@ use serde::{Deserialize, Serialize};
 pub struct HiddenValve;
 
 /// The log-likelihood ratio from which the family votes stiction: above every look-alike the
-/// oscillation, compression and OP-range gates let through on the two calibration sets, rounded
-/// up to 5 (the routine windows' highest 58.5, a healthy valve under a load drift; the fast
-/// loops' 46.2, an external oscillation; with 100 particles and Box-Muller draws, before, 58.1
-/// and 53.6), so 60 until the routine calibration set gained its look-alikes with load steps and
-/// with a fed-forward load (2026-11-27): one of those, a load step, reaches 74.1, so the same
-/// rule gives 75 (2026-11-29). Since the cycling load may sit at the period of the cycle the
-/// loop shows, the fast loops' highest is 70.4 (an external oscillation), the routine windows' still
-/// 74.1, so 75 stands. The benchmark sets were judged at it after
-/// (stiction-lab/results/plant-benchmark-thorough.md, stiction-lab/journal/accuracy-history.md).
+/// oscillation, compression and OP-range gates let through on the two calibration sets, rounded up
+/// to 5.
 pub(crate) const THRESHOLD: f64 = 75.0;
 /// OP's travel (5th to 95th percentile, twice its amplitude) above this share of the valve span
 /// leaves the family silent: on the routine calibration windows an equal-percentage valve under a
@@ -46,9 +39,9 @@ const MAX_OP_TRAVEL: f64 = 0.10;
 /// family silent: a held or straight-lined PV is no Gaussian measurement, and compressed records
 /// reach ratios in the thousands (stiction-lab/results/hidden-valve-routine.md).
 const MAX_UNRECORDED: f64 = 0.05;
-/// Particles of the sticky hypothesis's filter (the calibrated setting). 100 before: on the fast
-/// calibration and benchmark sets' 113 loops the family judges, 50 call the same sticky loops
-/// sticky (one more) and leave every look-alike under the threshold, at half the cost.
+/// Particles of the sticky hypothesis's filter (the calibrated setting): on the fast sets as many
+/// sticky loops found as with twice as many, every look-alike under the threshold, at half the
+/// cost.
 pub(crate) const PARTICLES: usize = 50;
 /// Valves each sticky search starts from: the scan's best and the best a band away from it
 /// ([`TestSettings::band_starts`]). With the best alone the search stayed at a small band on
@@ -56,13 +49,8 @@ pub(crate) const PARTICLES: usize = 50;
 /// found a ratio of 149 to 179.
 const BAND_STARTS: usize = 2;
 /// Draws of the particle filter's noise (seeds 1, 2, ...) whose median ratio decides a stiction
-/// vote: a ratio at or above the threshold is drawn again with other seeds. On the 249 loops the
-/// family judged on the four plant-benchmark sets, one draw against another moved 12 votes
-/// (the ratio's spread over three draws: median 2, 90th percentile 20, largest 102); a
-/// look-alike reached 74 and another 103 with other draws than the first, and their medians are
-/// 46 and 10. The median of three kept every look-alike of the calibration sets under 60 (58.2
-/// and 46.2) and no sticky loop whose first draw alone passed with the other two far under it
-/// (fast-c-0026: 103, then 5 and 3).
+/// vote: a ratio at or above the threshold is drawn again with other seeds, since one draw against
+/// another can carry a ratio across it.
 pub(crate) const DRAWS: u64 = 3;
 /// How far short of OP the hidden valve's slips may land, as shares of its band (0: Stenman's
 /// valve; He's lands `fd` short).

@@ -6,8 +6,8 @@ use crate::diagnose::result::{Verdict, Vote};
 
 /// Below this confidence a `no_stiction` rests only on weak votes against (a fit no better than
 /// healthy loops give, no stick-slip episode found), which a sticky valve often gives too: on the
-/// plant benchmark's routine windows such verdicts were right in 148 of 236 loops (63 %), those
-/// at 0.8 or more in 19 of 20 (stiction-lab/results/plant-benchmark.md, "What the confidence means here").
+/// plant benchmark's routine windows such verdicts are right far less often than those at 0.8 or
+/// more (stiction-lab/results/plant-benchmark.md, "What the confidence means here").
 const WEAK_NO_STICTION: f64 = 0.6;
 
 /// Added to a weak verdict's next step when the setpoint holds over the whole stretch.
@@ -15,10 +15,9 @@ const STEADY_SETPOINT: &str =
     ", or judge a window that holds setpoint changes (here the setpoint holds, so the fits can hardly tell the process from the load)";
 
 /// One line: what to do next; on a record whose PV is mostly not recorded, a verdict other than
-/// `stiction` also says that compression hides sticks (measured by the `compressed_sticky`
-/// example: the routine benchmark's sticky loops with their PV compressed are called `stiction`
-/// in 42.1 %, 65.8 % as recorded; stiction-lab/results/compressed-sticky.md, 2026-11-29, late afternoon; 39.6 and
-/// 55.4 % before the statistics read together).
+/// `stiction` also says that compression hides sticks (measured by the lab's `compressed_sticky`
+/// study: the routine benchmark's sticky loops are called `stiction` far less often with their PV
+/// compressed).
 pub(super) fn next_step(
     verdict: Verdict,
     confidence: Option<f64>,
@@ -40,9 +39,9 @@ pub(super) fn next_step(
 /// A `stiction` verdict's next step without a recorded valve position.
 const TRAVEL_TEST: &str = "valve travel test recommended (small OP steps in manual, watching PV or the valve position) to confirm before maintenance";
 
-/// Added to a `stiction` verdict's next step when only the cycle voted stiction (its shape, or
-/// its steady, free-running rhythm): another loop's stiction cycle, carried through the process
-/// or a cascade's setpoint, gives both (the `propagated_oscillation` example;
+/// Added to a `stiction` verdict's next step when only the cycle voted stiction (its shape, or its
+/// steady, free-running rhythm): another loop's stiction cycle, carried through the process or a
+/// cascade's setpoint, gives both (the lab's `propagated_oscillation` study;
 /// stiction-lab/results/propagated-oscillation.md).
 const CYCLE_ALONE: &str = "only the cycle (its shape or its steady, free-running rhythm) points to the valve, and another \
 loop's sticky valve cycling this loop gives that too (healthy loops cycled by one in simulation: 39 of 236 called stiction \

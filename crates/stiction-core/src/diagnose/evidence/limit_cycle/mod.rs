@@ -92,16 +92,12 @@ const UNSTEADY_SCATTER: f64 = 0.25;
 /// and its phase wanders more than [`FREE_RUNNING`]. Set on the plant benchmark's calibration
 /// sets: no look-alike there holds its amplitude this well while its phase runs free.
 const STEADY_SCATTER: f64 = 0.15;
-/// Over at least [`STEADY_CYCLES`] cycles a steady amplitude may scatter up to this. The scatter
-/// of a cycle that noise drives through a linear loop (its envelope Rayleigh-like: 0.64 in the
-/// long run) cannot come out this low by chance over so many cycles, and an envelope that swells
-/// slowly shows its swell. On the pooled calibration draws (the calibration set and draws 1-9 of
-/// both suites; over 30 cycles, amplitude changing under 50 %, phase free, OP explaining the
-/// PV's cycle) the look-alikes' scatters start at 0.38 (external oscillation), 0.44 (aggressive
-/// tuning) and, but for 3 loops at 0.08-0.19, 0.26 (near-unstable), while 20 sticky valves that
-/// were not called sticky lie between 0.15 and 0.25. Fast sticky loops called stiction there:
-/// 72.7 to 74.3 %; near-unstable loops called stiction 2.7 to 3.0 % (one loop); in the routine
-/// suite 3 sticky loops went from undetermined to stiction, nothing else changed.
+/// Over at least [`STEADY_CYCLES`] cycles a steady amplitude may scatter up to this. The scatter of
+/// a cycle that noise drives through a linear loop (its envelope Rayleigh-like: 0.64 in the long
+/// run) cannot come out this low by chance over so many cycles, and an envelope that swells slowly
+/// shows its swell. On the pooled calibration draws the look-alikes' scatters start above it (but
+/// for 3 near-unstable loops), while sticky valves that were not called sticky lie between
+/// [`STEADY_SCATTER`] and it.
 const STEADY_SCATTER_LONG: f64 = 0.25;
 /// The cycles over which [`STEADY_SCATTER_LONG`] applies.
 const STEADY_CYCLES: usize = 30;

@@ -9,12 +9,8 @@
 //! compared over a third of the bound, and the comparison with the higher test ratio is kept:
 //! both are the same calibrated test on the same record.
 //!
-//! Set on the catalogue's calibration set (routine windows; at a half, a third and a quarter of
-//! the bound): at a third, 5 more sticky valves called `stiction` and one lost (109 -> 114 of
-//! 240), no false alarm added; at a half, 3 more and none lost; at a quarter, as at a third but
-//! one false alarm more. Checked on the benchmark set (at a
-//! third): 4 more sticky valves (129 -> 133 of 240) and one slow process with a long delay
-//! newly called `stiction` (false alarms 9 -> 10).
+//! A third, set on the catalogue's calibration set (routine windows): it finds more sticky valves
+//! than a half, and adds no false alarm where a quarter does.
 
 use super::Levels;
 use crate::quantify::{compare_fits, max_lag, off_the_pv_cycle, CompareRequest, FitComparison};

@@ -16,10 +16,9 @@
 //! whether or not it stands out of the noise as an oscillation), where the fitted valve gives PV
 //! harmonics of at least [`FIT_HARMONICS`] of its cycle's power and [`FOREIGN_SHAPE`] times or
 //! more those of the recorded PV, the fit's stiction vote is withdrawn: its band reproduces the
-//! cycle's timing with a shape PV does not have. Measured on the batch benchmark's mix (outside
-//! the catalogue: a sine of period 100-250 s added to PV, the setpoint constant; 250 loops), 9
-//! of its 19 loops called `stiction` are no longer, and on the catalogue's 18 sets, the ISDB and
-//! the 108 loops no verdict moves (stiction-lab/journal/accuracy-history.md).
+//! cycle's timing with a shape PV does not have. It clears healthy loops with a sine added to PV
+//! (the batch benchmark's mix); on the catalogue's sets and the ISDB no fit that decides a verdict
+//! has so foreign a shape.
 
 use super::{Context, LIMIT_CYCLE_REGULARITY};
 use crate::diagnose::evidence::limit_cycle::{measurable_harmonics, MIN_HARMONICS};

@@ -9,20 +9,16 @@
 //! test in 36). The levels test has no PV past among its regressors and cannot be biased towards
 //! OP by the controller's feedback of PV's noise.
 //!
-//! Its threshold, [`LEVELS_STICTION`], is about the 98th percentile of the test's ratio on the 159
+//! Its threshold, [`LEVELS_STICTION`], is about the 98th percentile of the test's ratio on the
 //! healthy routine loops of the catalogue's calibration set with PV recorded (other seeds than the
-//! benchmark's): their 95th and 97.5th percentiles are 21 and 41, and 3 of them reach 50 (of the
-//! 136 healthy fast loops, 1). At 30 the test called 3 more of the 30 externally oscillating
-//! routine loops sticky. A PV that is not recorded over [`MAX_UNRECORDED`] of the record (historian
-//! compression, a frozen or coarsely quantised transmitter) is left out: a held PV is a staircase
-//! that a sticky valve's trajectory fits.
+//! benchmark's); lower, it calls externally oscillating loops sticky. A PV that is not recorded
+//! over [`MAX_UNRECORDED`] of the record (historian compression, a frozen or coarsely quantised
+//! transmitter) is left out: a held PV is a staircase that a sticky valve's trajectory fits.
 //!
 //! A band under [`crate::diagnose::evidence::valve::MIN_BAND_PERCENT`] of span is not counted:
 //! where even the recorded valve position would not call so small a band stiction, PV's levels
-//! cannot. On the catalogue's routine windows with load steps the test's best valve was such a
-//! band (0.04-0.07 % of span, over OP's noise of 0.01-0.02 %) at ratios of 64 to 146, and one of
-//! them was called `stiction` for it; the sticky valves' bands it found were 0.2 % and more
-//! (`stiction-lab/journal/accuracy-history.md`, 2026-11-29 evening).
+//! cannot. On the catalogue's routine windows with load steps the test's best valve was such a band
+//! at high ratios, where the sticky valves' bands it finds are larger.
 
 use super::super::valve::MIN_BAND_PERCENT;
 use super::super::Context;

@@ -8,19 +8,15 @@
 //! shares of the PV's variance above its noise. A free band always explains noise a little better,
 //! so the decision is a calibrated test, not a raw R² gap: the improvement is held against the
 //! stiction fit's own residual per independent change of the record, an F-like ratio, and must
-//! exceed what simulated healthy loops of many kinds give (`cargo run --release -p stiction-core
-//! --example calibrate`: the catalogue's calibration set, other seeds than the benchmark's; the
-//! threshold lies at about the 95th percentile of its healthy routine loops). The plant
-//! data judged are never the training set.
+//! exceed what simulated healthy loops of many kinds give (the lab's `calibrate` study: the
+//! catalogue's calibration set, other seeds than the benchmark's; the threshold lies at about the
+//! 95th percentile of its healthy routine loops). The plant data judged are never the training set.
 //!
 //! An independent change spans the samples of the residual's long-run overlap with the change the
 //! band makes to the fit ([`FitComparison::correlation_span`]): about the lag for noise, many more
 //! where the residual and the band's effect share a cycle that OP does not drive. A band that
 //! follows an external cycle therefore gains less than a valve's stick would, per independent
-//! change. (Before, the span was the lag: external oscillations and noisy healthy loops passed
-//! the test more often. On the calibration set the healthy loops' 95th percentile moved from 10
-//! to 42, and at the same healthy percentile the test finds 37 % of the sticky routine loops
-//! instead of 32 %, and 61 % of the sticky fast loops instead of 48 %.)
+//! change.
 
 mod bound;
 mod cycle;
@@ -55,14 +51,10 @@ use levels::LevelsTest;
 /// The model family.
 pub struct Model;
 
-/// The test's ratio at and above which the fit votes stiction: set between the 95th and 97.5th
-/// percentiles healthy simulated routine loops gave (calibration set: 47 and 96; over it and
-/// nine more draws, 2,078 not-sticky routine loops, the 95th percentile is 55 and 5.6 % reach
-/// 50. Before the fits' delays stopped short of the lag: 42 and 55, and 51 and 5.2 %). Since the
-/// look-alikes with load steps and with a fed-forward load joined the calibration set (264
-/// not-sticky routine loops; `stiction-lab/results/calibration.md`, 2026-11-27) the 95th and 97.5th percentiles
-/// are 55 and 129 and 6 % reach 50: those look-alikes' high ratios are a fit that mirrors the
-/// controller or follows OP's unprovoked steps, and such votes are withdrawn (`withdraw.rs`).
+/// The test's ratio at and above which the fit votes stiction: between the 95th and 97.5th
+/// percentiles that the healthy simulated routine loops of the calibration set give
+/// (`stiction-lab/results/calibration.md`). The look-alikes above it are mostly fits that mirror
+/// the controller or follow OP's unprovoked steps, and such votes are withdrawn (`withdraw.rs`).
 pub(crate) const SIGNIFICANCE_STICTION: f64 = 50.0;
 /// The ratio at which a stiction vote is held with full strength.
 const SIGNIFICANCE_DECISIVE: f64 = 500.0;
@@ -115,22 +107,16 @@ const ELSEWHERE_STRENGTH: f64 = 0.9;
 /// (`ELSEWHERE_WEAK_STRENGTH`). On the catalogue's calibration sets (routine and fast) 20 of the
 /// 21 loops under 0.15 have a healthy valve, 10 of the 17 between 0.15 and 0.3.
 const ELSEWHERE_CLEAR: f64 = 0.15;
-/// Strength of the vote against stiction when OP explains between [`ELSEWHERE_CLEAR`] and
-/// [`MIN_EXPLAINED`]: just over the verdict's weak dissent, so it still keeps a lone vote for
-/// stiction from deciding (every verdict of the plant benchmark stays as it was), while a
-/// `no_stiction` resting on it is no longer given 0.93 (with the stick-slip family's weak vote:
-/// 0.66). Of the `no_stiction` verdicts at 0.8 or more, 81 % were right on the calibration set's
-/// routine windows and 88 % on the benchmark set's; with the vote graded, 95 % on both.
+/// Strength of the vote against stiction when OP explains between `ELSEWHERE_CLEAR` and
+/// `MIN_EXPLAINED`: just over the verdict's weak dissent, so it still keeps a lone vote for
+/// stiction from deciding, while a `no_stiction` resting on it is not given a high confidence (such
+/// verdicts are right less often than the confident ones).
 const ELSEWHERE_WEAK_STRENGTH: f64 = 0.55;
 /// Fewest changes over the lag that do not overlap (samples over the lag) for the test.
 const MIN_INDEPENDENT: f64 = 8.0;
 /// Below this share of the PV's variance above its noise the record carries too little signal. The
-/// noise is PV's fast changes, but no more than the best fit leaves: on the plant benchmark's
-/// calibration set, 27 of the 540 routine windows whose fits explain 5 to 96 % of PV's changes
-/// were "barely varying above their noise" before (a loop's own fast moves, recorded every
-/// 10 s, pass for noise); 7 not-sticky ones among them were left `insufficient_data` or
-/// `undetermined` and are now `no_stiction`; of the sticky ones, one is now `stiction`, one
-/// `no_stiction`; of the backlash valves, one `stiction`, two `no_stiction`.
+/// noise is PV's fast changes, but no more than the best fit leaves: a loop's own fast moves,
+/// recorded every 10 s, would otherwise pass for noise.
 const MIN_SIGNAL_SHARE: f64 = 0.05;
 
 /// How the thresholds were set, reported with every result.

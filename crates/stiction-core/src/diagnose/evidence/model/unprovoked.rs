@@ -21,12 +21,9 @@ pub(crate) const STEP_SIGMAS: f64 = 6.0;
 /// controller slower than the record acts on every error since it last ran).
 const QUIET_SIGMAS: f64 = 3.0;
 /// The share of OP's travel in unprovoked steps from which the model family's stiction vote is
-/// withdrawn. On the catalogue's calibration sets (`plant_benchmark --calibration --jsonl`) no
-/// sticky loop has a single unprovoked step (routine windows and fast loops; nor on the benchmark
-/// sets, checked after); the false alarms it withdraws there are two fed-forward loads' (0.018
-/// and 0.097 of OP's travel) and two quantised PVs' (0.012 and 0.029). On the benchmark set it
-/// withdrew three fed-forward loads' (0.010, 0.029, 0.087), a quantised PV's (0.012) and a load
-/// step's (0.014), and no sticky loop's verdict moved.
+/// withdrawn: no sticky loop of the catalogue's calibration and benchmark sets has a single
+/// unprovoked step, where the false alarms it withdraws (fed-forward loads, quantised PVs, a load
+/// step) hold 0.01 to 0.1 of OP's travel in them.
 const MAX_UNPROVOKED_SHARE: f64 = 0.01;
 
 /// OP's unprovoked steps on the analysed stretch.

@@ -12,14 +12,10 @@ use crate::quantify::FitComparison;
 /// does not limit-cycle, the stiction vote is withdrawn: the fit mirrors the controller. Where a
 /// load that OP does not explain moves the loop (load steps above all), closed-loop data let a
 /// linear fit explain PV's changes from OP's through the controller's own law (OP answers the
-/// error), with a process gain near zero and no dead time, and a free band then gains on that
-/// fit as it never would on the process's. On the catalogue's calibration set (routine windows,
-/// loops that do not limit-cycle), the sticky valves' stiction votes imply loop gains of 0.157
-/// and more; the look-alike with load steps called sticky, 0.000 to 0.077 (5 of its 6 false
-/// alarms; the sixth 1.2), and a compressed PV's false alarm 0.000. At 0.1 the calibration set's
-/// false alarms fall from 14 to 8 and no sticky loop's verdict moves; limit cycles are left
-/// alone (there the valve drives the loop, and a PI read off fast samples is unreliable: two
-/// sticky fast loops would lose their verdict).
+/// error), with a process gain near zero and no dead time, and a free band then gains on that fit
+/// as it never would on the process's. Set between the look-alikes' loop gains and the sticky
+/// valves' on the calibration set; limit cycles are left alone (there the valve drives the loop,
+/// and a PI read off fast samples is unreliable).
 pub(crate) const MIN_LOOP_GAIN: f64 = 0.1;
 
 /// Why a stiction vote is withdrawn ([`mirrors_controller`], then [`moved_elsewhere`]), with the
