@@ -167,7 +167,7 @@ FEATURES = pathlib.Path(__file__).resolve().parents[3] / "crates/stiction-core/s
 def placeholder(out):
     """Trees that read the statistics `features.rs` names and never decide (one leaf, a
     probability of about 2e-9): the build then reports the new statistics to train on."""
-    table = FEATURES.read_text().split("pub const NAMES")[1].split("];")[0]
+    table = FEATURES.read_text().split(" const NAMES")[1].split("];")[0]
     names = re.findall(r'\(\s*"([a-z0-9_]+)",', table)
     forest = {
         "features": names,
