@@ -211,17 +211,17 @@ pub fn rank(rows: &mut [Row]) {
 /// Two loops oscillate at one period when their periods lie within this share of each other: a
 /// cycle carried from loop to loop (another loop's sticky valve, through the process or a
 /// cascade's setpoint) keeps its period, but its estimate in a loop it reaches scatters (the
-/// `propagated_oscillation` example: 54 % of the regular ones within 5 % of the source's period,
+/// lab's `propagated_oscillation` study: 54 % of the regular ones within 5 % of the source's period,
 /// 73 % within 10 %).
 const SAME_PERIOD: f64 = 0.10;
 /// A loop's cycle counts from this regularity (Thornhill's: over 1, a regular oscillation).
 const REGULAR: f64 = 1.0;
 
 /// For each row, how many other rows oscillate at its period (`SAME_PERIOD`; both regular,
-/// `REGULAR`); 0 for a row that does not oscillate. Where several loops of one unit share a
-/// period, one of them may drive the others: a stiction verdict on a loop that shares its period
-/// is read with that in mind (stiction-lab/results/propagated-oscillation.md). Loops from different units or
-/// time windows can share a period by chance.
+/// `REGULAR`); 0 for a row that does not oscillate. Where several loops of one unit share a period,
+/// one of them may drive the others: a stiction verdict on a loop that shares its period is read
+/// with that in mind (stiction-lab/results/propagated-oscillation.md). Loops from different units
+/// or time windows can share a period by chance.
 pub fn same_period<'a>(rows: impl IntoIterator<Item = &'a Row>) -> Vec<usize> {
     let periods: Vec<Option<f64>> = rows
         .into_iter()

@@ -1,9 +1,9 @@
 //! What a record like this one can show of a sticky valve. Proportional action passes the PV's
 //! noise on to OP; a band of a few of OP's noise standard deviations is crossed by the noise alone,
 //! and the valve then moves in small jumps that look like a healthy valve's noise. On the
-//! catalogue's simulated sticky valves the families found few of the bands under [`SMALL`] OP
-//! noise standard deviations and most of those over `LARGE` (`stiction-lab/results/plant-benchmark.md`, the
-//! table by band over the OP's noise), so a `no_stiction` verdict speaks for large bands and is
+//! catalogue's simulated sticky valves the families found few of the bands under [`SMALL`] OP noise
+//! standard deviations and most of those over `LARGE` (`stiction-lab/results/plant-benchmark.md`,
+//! the table by band over the OP's noise), so a `no_stiction` verdict speaks for large bands and is
 //! nearly silent on small ones.
 
 use super::{DiagnoseRequest, Diagnosis, Family, FamilyEvidence};

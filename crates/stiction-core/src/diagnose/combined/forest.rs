@@ -1,8 +1,8 @@
-//! Gradient-boosted trees, as `stiction-lab/scripts/train_combined.py` writes them (`forest.json`): each node
-//! `[feature, threshold, left, right, value]`, a leaf where `left` is 0 (the root is node 0, so
-//! no child is). A sample goes left where its statistic is at or below the threshold. Every node
-//! carries the mean of the leaves under it (weighted by the training samples that reached them),
-//! so a path's steps split the tree's output among the statistics it asked about (Saabas'
+//! Gradient-boosted trees, as `stiction-lab/scripts/train_combined.py` writes them (`forest.json`):
+//! each node `[feature, threshold, left, right, value]`, a leaf where `left` is 0 (the root is node
+//! 0, so no child is). A sample goes left where its statistic is at or below the threshold. Every
+//! node carries the mean of the leaves under it (weighted by the training samples that reached
+//! them), so a path's steps split the tree's output among the statistics it asked about (Saabas'
 //! contributions): the trees' log-odds are the baseline, the roots' means and those steps.
 
 use crate::diagnose::result::Verdict;

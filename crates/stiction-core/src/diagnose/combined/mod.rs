@@ -6,12 +6,12 @@
 //! thresholds while the stick-slip episodes and the oscillation's amplitude say more), which
 //! finds sticky valves the rules leave `no_stiction` or `undetermined`.
 //!
-//! The trees only ever add a `stiction` verdict, and only from a probability calibrated to add
-//! few look-alikes: out of fold on their training loops, under one healthy loop in 200.
-//! They never take one away, never decide where the valve position is recorded, and never
-//! decide against stiction: a learned combination does not hold where the catalogue does not
-//! teach it (stiction-lab/journal/accuracy-history.md, "A learned combination of the families' statistics": as
-//! the whole verdict it lost ISDB loops whose statistics the catalogue has no example of), so
+//! The trees only ever add a `stiction` verdict, and only from a probability calibrated to add few
+//! look-alikes: out of fold on their training loops, under one healthy loop in 200. They never take
+//! one away, never decide where the valve position is recorded, and never decide against stiction:
+//! a learned combination does not hold where the catalogue does not teach it
+//! (stiction-lab/journal/accuracy-history.md, "A learned combination of the families' statistics":
+//! as the whole verdict it lost ISDB loops whose statistics the catalogue has no example of), so
 //! its low probabilities are no evidence. Where it decides, the verdict names the statistics that
 //! weighed most.
 

@@ -3,17 +3,17 @@
 //!
 //! Where the controller moves OP between the recorded samples, the valve slips at instants the
 //! record does not hold, so no valve model run on the recorded OP reproduces it and the fits with
-//! and without a band look alike (stiction-lab/results/sampled-valve.md); a particle filter over the valve's
-//! position sees every slip in PV. It costs seconds a loop (a few hundred particle filters), so it
-//! runs only with `thorough`, only where the other families have not already decided `stiction`,
-//! and only where it was calibrated: an oscillating loop, PV recorded (not compressed, not
-//! quantised), OP moving over a narrow range (a valve's characteristic is not linear over a wide
-//! one, and the hidden valve's slips then absorb the linear loop's misfit), and OP free of steps
-//! the control error did not provoke (`model::unprovoked`: a feed-forward's steps, through which
-//! a valve that sticks explains PV's stillness, as for the closed-loop fit; on a routine draw a
-//! fed-forward load reached a ratio of 253, and no sticky loop of the catalogue's sets has such a
-//! step). It votes stiction or not at all: a sticky valve's ratio can be small, so a small ratio
-//! is no evidence against it.
+//! and without a band look alike (stiction-lab/results/sampled-valve.md); a particle filter over
+//! the valve's position sees every slip in PV. It costs seconds a loop (a few hundred particle
+//! filters), so it runs only with `thorough`, only where the other families have not already
+//! decided `stiction`, and only where it was calibrated: an oscillating loop, PV recorded (not
+//! compressed, not quantised), OP moving over a narrow range (a valve's characteristic is not
+//! linear over a wide one, and the hidden valve's slips then absorb the linear loop's misfit), and
+//! OP free of steps the control error did not provoke (`model::unprovoked`: a feed-forward's steps,
+//! through which a valve that sticks explains PV's stillness, as for the closed-loop fit; on a
+//! routine draw a fed-forward load reached a ratio of 253, and no sticky loop of the catalogue's
+//! sets has such a step). It votes stiction or not at all: a sticky valve's ratio can be small, so
+//! a small ratio is no evidence against it.
 
 use super::model::{unprovoked, Unprovoked};
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};

@@ -343,7 +343,8 @@ fn harmonics_index(op: &[f64], pv: &[f64], osc: &Oscillation, ts: f64) -> Index 
 /// Choudhury, Shah and Thornhill (2004): the squared bicoherence of the control error; a
 /// non-Gaussian (NGI) and non-linear (NLI) error points to a non-linearity in the loop, most often
 /// the valve; a Gaussian one to a linear cause. Reported with its vote but weight 0: on our
-/// benchmark (stiction-lab/results/diagnose-benchmark.md) it did not separate stiction from other causes.
+/// benchmark (stiction-lab/results/diagnose-benchmark.md) it did not separate stiction from other
+/// causes.
 fn bicoherence_index(error: &[f64]) -> Index {
     let settings = BicoherenceSettings::default();
     let b = spectral::bicoherence(error, &settings);

@@ -25,9 +25,10 @@
 //! - a cascade's inner loop, its setpoint moving unrecorded: the PI of the recorded error does not
 //!   explain OP's cycle; without a setpoint the vote is weakened.
 //!
-//! Thresholds: set on simulated fast loops (`stiction-lab/examples/loop_benchmark.rs`, `stiction-lab/results/loop-benchmark.md`:
-//! sticky valves of Stenman, Kano and He; healthy valves with the look-alikes above), keeping the
-//! look-alikes' stiction votes at or under 3 % per class; never on the ISDB.
+//! Thresholds: set on simulated fast loops (`stiction-lab/examples/loop_benchmark.rs`,
+//! `stiction-lab/results/loop-benchmark.md`: sticky valves of Stenman, Kano and He; healthy valves
+//! with the look-alikes above), keeping the look-alikes' stiction votes at or under 3 % per class;
+//! never on the ISDB.
 
 mod measure;
 pub(crate) use measure::{measurable_harmonics, share_of_cycles};

@@ -2,12 +2,12 @@
 //! valve trajectory from OP scored on PV's *levels* against a filter bank beside a smooth drift,
 //! with an AR noise model ([`crate::identify::levels`]).
 //!
-//! Why a second test: the closed-loop fit compares PV's changes over a lag with PV's own past
-//! among its regressors, and on records sampled at every controller execution that criterion
-//! often ranks the true band's valve below a small band near OP (stiction-lab/results/sampled-valve.md: on the
-//! routine 1 s records it prefers the true band's valve in 10 of 40 Stenman loops; the levels
-//! test in 36). The levels test has no PV past among its regressors and cannot be biased towards
-//! OP by the controller's feedback of PV's noise.
+//! Why a second test: the closed-loop fit compares PV's changes over a lag with PV's own past among
+//! its regressors, and on records sampled at every controller execution that criterion often ranks
+//! the true band's valve below a small band near OP (stiction-lab/results/sampled-valve.md: on the
+//! routine 1 s records it prefers the true band's valve in 10 of 40 Stenman loops; the levels test
+//! in 36). The levels test has no PV past among its regressors and cannot be biased towards OP by
+//! the controller's feedback of PV's noise.
 //!
 //! Its threshold, [`LEVELS_STICTION`], is about the 98th percentile of the test's ratio on the
 //! healthy routine loops of the catalogue's calibration set with PV recorded (other seeds than the
