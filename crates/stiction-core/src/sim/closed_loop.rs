@@ -355,11 +355,31 @@ impl ClosedLoop {
     /// Sample the trace at the recording times and pass it through the historian.
     fn record(&self, plan: &Plan, tr: &Trace) -> LoopRun {
         let idx = &plan.recorded;
-        let pick = |v: &[f64]| idx.iter().map(|&j| v[j]).collect::<Vec<f64>>();
+        let per = ((self.ts / plan.dt).round() as usize).max(1);
+        let average = self.historian.average;
+        // the setpoint is a setting, kept as the latest value
+        let latest = |v: &[f64]| idx.iter().map(|&j| v[j]).collect::<Vec<f64>>();
+        let pick = |v: &[f64]| -> Vec<f64> {
+            if !average {
+                return latest(v);
+            }
+            idx.iter()
+                .enumerate()
+                .map(|(k, &j)| {
+                    // the plant steps since the previous recording (the first: one interval)
+                    let from = if k == 0 {
+                        j + 1 - per.min(j + 1)
+                    } else {
+                        idx[k - 1] + 1
+                    };
+                    v[from..=j].iter().sum::<f64>() / (j + 1 - from) as f64
+                })
+                .collect()
+        };
         let t: Vec<f64> = (0..idx.len()).map(|k| k as f64 * self.ts).collect();
         let mut data = LoopData {
             t: t.clone(),
-            sp: pick(&tr.sp),
+            sp: latest(&tr.sp),
             op: pick(&tr.op),
             mv: pick(&tr.mv),
             pv: pick(&tr.pv),
@@ -375,7 +395,7 @@ impl ClosedLoop {
         }
         let outer = tr.outer.as_ref().map(|o| LoopData {
             t: t.clone(),
-            sp: pick(&o.sp),
+            sp: latest(&o.sp),
             op: pick(&o.op),
             mv: Vec::new(),
             pv: pick(&o.pv),

@@ -118,12 +118,17 @@ pub struct Historian {
     /// Compression of the recorded OP, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub op: Option<Compression>,
+    /// Each recorded value is the mean of the plant steps since the previous recording time, as
+    /// a historian that stores averages over its interval keeps them (a slip then spreads over
+    /// one or two samples, OP's small steps are smoothed); otherwise the latest value.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub average: bool,
 }
 
 impl Historian {
-    /// Whether neither signal is compressed.
+    /// Whether the historian records the latest values, uncompressed.
     pub fn is_none(&self) -> bool {
-        self.pv.is_none() && self.op.is_none()
+        self.pv.is_none() && self.op.is_none() && !self.average
     }
 
     /// An error unless every compression's deviation is >= 0.

@@ -64,6 +64,29 @@ fn the_historian_samples_the_latest_controller_values() {
 }
 
 #[test]
+fn an_averaging_historian_records_the_mean_of_each_interval() {
+    // a record every 10 s of averages equals the means of a 1 s record's ten samples up to it
+    let mut fine = busy_loop(Model::Stenman(Stenman { d: 1.0 }));
+    fine.controller_period = Some(1.0);
+    fine.ts = 1.0;
+    fine.samples = 1000;
+    let mut coarse = fine.clone();
+    coarse.ts = 10.0;
+    coarse.samples = 100;
+    coarse.historian.average = true;
+    let (f, c) = (fine.run().unwrap(), coarse.run().unwrap());
+    for k in 1..100 {
+        let window = 10 * k - 9..=10 * k;
+        for (a, b) in [(&c.op, &f.op), (&c.pv, &f.pv), (&c.mv, &f.mv)] {
+            let mean = b[window.clone()].iter().sum::<f64>() / 10.0;
+            assert!((a[k] - mean).abs() < 1e-9, "sample {k}: {} vs {mean}", a[k]);
+        }
+        // the setpoint is a setting: its latest value
+        assert_eq!(c.sp[k], f.sp[10 * k]);
+    }
+}
+
+#[test]
 fn substeps_record_the_plant_between_controller_executions() {
     // no lag, no noise, a delay of whole controller periods: the valve's position is held over
     // each period, so stepping the plant three times per period changes nothing the controller sees
