@@ -104,7 +104,7 @@ pub struct FleetRow {
     pub verdict_words: &'static str,
     /// The verdict's place in the ranking order (stiction first), its sort key.
     pub verdict_rank: usize,
-    pub confidence: Cell,
+    pub probability: Cell,
     pub severity: Cell,
     pub band: Cell,
     /// Where the verdict is not `stiction`: the band, % of span, under which a sticky valve
@@ -164,11 +164,11 @@ struct FleetPage<'a> {
     reach: ReachWords,
 }
 
-/// What the "hidden under" column means, from the calibration of `diagnose::reach`.
+/// What the "hidden under" column means: the small band of `diagnose::reach`, in OP noise
+/// standard deviations.
 #[derive(Serialize)]
 struct ReachWords {
     times: String,
-    found: String,
 }
 
 /// One loop of the page: the fleet row, its source in words, whether it has a report, its
@@ -195,7 +195,7 @@ pub fn row(rank: usize, e: &Entry) -> FleetRow {
             .iter()
             .position(|&o| o == r.verdict)
             .unwrap_or(0),
-        confidence: cell(r.confidence),
+        probability: cell(r.probability),
         severity: cell(Some(r.severity)),
         band: cell(r.band_percent_of_span),
         hidden: cell(
@@ -242,7 +242,6 @@ pub fn page(rows: &[FleetRow], counts: &Counts, complete: bool) -> Result<String
             back: None,
             reach: ReachWords {
                 times: format!("{}", reach::SMALL),
-                found: reach::found_words(reach::FOUND_SMALL),
             },
         },
     )

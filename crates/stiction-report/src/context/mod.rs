@@ -6,11 +6,11 @@ use super::plots::{self, Figure, PHASE_SIZE, TREND_SIZE};
 use super::sections::{self, Estimates, Evidence, KvRow, Notes, Quality, Windows};
 use super::series::{self, LONG_RECORD};
 use super::PageOptions;
-use crate::words::{capital, duration, num, verdict};
+use crate::words::{self, capital, duration, num, verdict};
 use crate::{ColumnNames, LoopData};
 use anyhow::Result;
 use serde::Serialize;
-use stiction_core::diagnose::{Diagnosis, Verdict};
+use stiction_core::diagnose::{Diagnosis, Reason, Verdict, VerdictModel};
 use stiction_core::quantify::{Quantification, QuantifyStatus};
 
 mod figures;
@@ -56,14 +56,25 @@ pub fn rich(t: impl Into<String>) -> Rich {
 pub struct VerdictBox {
     pub code: &'static str,
     pub word: String,
-    pub confidence: Option<String>,
+    /// The probability of a sticky valve, as the page prints it.
+    pub probability: Option<String>,
     pub bar_percent: Option<f64>,
-    pub reason: Option<String>,
-    pub evidence: Vec<String>,
+    /// The verdict's thresholds on the bar, % of its width, and in words.
+    pub thresholds: Thresholds,
+    /// The one or two findings that decided the verdict, in words.
+    pub reasons: Vec<String>,
     pub band: Option<BandLine>,
     pub next_step: String,
     /// What a record like this one can show (verdicts other than stiction).
     pub reach: Option<String>,
+}
+
+/// The verdict model's thresholds, where the bar marks them.
+#[derive(Serialize)]
+pub struct Thresholds {
+    pub below_percent: f64,
+    pub from_percent: f64,
+    pub words: String,
 }
 
 #[derive(Serialize)]
@@ -192,7 +203,7 @@ fn toc(d: &Diagnosis, zoom: bool) -> Vec<Link> {
     }
     links.extend([
         ("phase", "PV against OP"),
-        ("indices", "Indices"),
+        ("evidence", "How it was decided"),
         ("oscillation", "Oscillation"),
         ("estimates", "Estimates"),
         ("convergence", "Convergence"),
@@ -212,19 +223,21 @@ fn toc(d: &Diagnosis, zoom: bool) -> Vec<Link> {
 }
 
 fn verdict_box(d: &Diagnosis) -> VerdictBox {
-    // for insufficient data and a loop without oscillation the evidence repeats the reason
-    let repeats_reason = matches!((d.evidence.as_slice(), &d.reason), ([e], Some(r)) if e == r);
+    let model = VerdictModel::embedded();
     VerdictBox {
         code: d.verdict.as_str(),
         word: capital(verdict(d.verdict)),
-        confidence: d.confidence.map(|c| format!("{c:.2}")),
-        bar_percent: d.confidence.map(|c| (c.clamp(0.0, 1.0) * 100.0).round()),
-        reason: d.reason.clone(),
-        evidence: if repeats_reason {
-            vec![]
-        } else {
-            d.evidence.clone()
+        probability: d.probability.map(|p| format!("{p:.2}")),
+        bar_percent: d.probability.map(|p| (p.clamp(0.0, 1.0) * 100.0).round()),
+        thresholds: Thresholds {
+            below_percent: (100.0 * model.no_stiction_below).round(),
+            from_percent: (100.0 * model.stiction_from).round(),
+            words: format!(
+                "no stiction under {:.2}, stiction from {:.2}, undetermined between",
+                model.no_stiction_below, model.stiction_from
+            ),
         },
+        reasons: d.reasons.iter().map(reason_text).collect(),
         band: d.band.as_ref().map(|b| BandLine {
             percent: num(b.band_percent_of_span),
             set: b
@@ -232,12 +245,25 @@ fn verdict_box(d: &Diagnosis) -> VerdictBox {
                 .map(|[lo, hi]| format!("optimal set {} to {} %", num(lo), num(hi))),
             source: b.source.words(),
         }),
-        next_step: d.next_step.clone(),
+        next_step: if d.next_step.text.is_empty() {
+            words::next_step(&d.next_step)
+        } else {
+            d.next_step.text.clone()
+        },
         reach: d
             .reach
             .as_ref()
             .filter(|_| d.verdict != Verdict::Stiction)
-            .map(|r| r.words()),
+            .map(words::reach),
+    }
+}
+
+/// A reason's words: its `text` when the front end filled it, else worded here.
+pub fn reason_text(r: &Reason) -> String {
+    if r.text.is_empty() {
+        words::reason(r)
+    } else {
+        r.text.clone()
     }
 }
 

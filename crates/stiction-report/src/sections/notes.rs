@@ -20,8 +20,8 @@ pub fn notes(d: &Diagnosis, q: Option<&Quantification>, reading: &[String]) -> N
     let caveat = match d.quantification.as_ref() {
         Some(q) => capital(&q.caveat),
         None => {
-            "No closed-loop estimate was run: the verdict rests on the indices, which read the \
-                 valve's behaviour from OP and PV without measuring the valve position"
+            "No closed-loop estimate was run: the verdict rests on the statistics the families \
+                 read from OP and PV, without measuring the valve position"
                 .into()
         }
     };

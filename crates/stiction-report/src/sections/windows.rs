@@ -25,7 +25,7 @@ pub struct WindowRow {
     pub samples: String,
     pub time: String,
     pub verdict: Chip,
-    pub confidence: String,
+    pub probability: String,
     pub period: String,
     pub votes: Vec<(&'static str, Chip)>,
     pub reason: String,
@@ -72,20 +72,25 @@ pub fn windows(d: &Diagnosis) -> Option<Windows> {
             samples: format!("{} to {}", w.start, w.end),
             time: format!("{} to {}", num(w.t_start), num(w.t_end)),
             verdict: verdict_chip(w.verdict),
-            confidence: w.confidence.map_or("–".into(), |c| format!("{c:.2}")),
+            probability: w.probability.map_or("–".into(), |p| format!("{p:.2}")),
             period: w.period.map_or("–".into(), duration),
             votes: w
                 .votes
                 .iter()
                 .map(|(n, v)| (n.words(), vote_chip(*v)))
                 .collect(),
-            reason: w.reason.clone().unwrap_or_default(),
+            reason: w
+                .reasons
+                .iter()
+                .map(crate::context::reason_text)
+                .collect::<Vec<_>>()
+                .join("; "),
         })
         .collect();
     Some(Windows {
         strip,
         legend,
-        reasons: d.windows.iter().any(|w| w.reason.is_some()),
+        reasons: d.windows.iter().any(|w| !w.reasons.is_empty()),
         rows,
     })
 }

@@ -1,6 +1,24 @@
-//! Small pieces of stiction's wording: counts with the right plural, seconds rounded for a
-//! person to read, numbers as the report prints them, and each verdict, outcome and vote named
-//! once for the terminal (the CLI uses this module), the loop report and the fleet page.
+//! Stiction's words, written once for the terminal (the CLI uses this module), the loop report,
+//! the fleet page and Python: the verdict's reasons and next step from the core's typed values
+//! ([`finding`], [`reason`], [`next_step`], all filled into a diagnosis by [`fill`]), the
+//! statistics of the verdict's model by name ([`statistic`]), and the small pieces: counts with
+//! the right plural, seconds rounded for a person to read, numbers as the pages print them, and
+//! each verdict, outcome and vote named once.
+//!
+//! The words quote the record's own figures, never a benchmark's.
+
+mod figures;
+mod fill;
+mod findings;
+mod next_step;
+mod reach;
+mod statistics;
+
+pub use fill::fill;
+pub use findings::{finding, reason};
+pub use next_step::{action, next_step};
+pub use reach::reach;
+pub use statistics::{statistic, statistic_value};
 
 use stiction_core::diagnose::{Verdict, Vote};
 use stiction_core::fleet::Outcome;
