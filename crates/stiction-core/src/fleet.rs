@@ -74,8 +74,8 @@ pub struct Row {
     pub source: String,
     /// Its outcome.
     pub verdict: Outcome,
-    /// The diagnosis' confidence; `None` for a failed loop.
-    pub confidence: Option<f64>,
+    /// The probability of a sticky valve; `None` for a failed loop or one not judged.
+    pub probability: Option<f64>,
     /// See [`severity`].
     pub severity: f64,
     /// The stiction band of a `stiction` verdict, % of valve span, and where it comes from.
@@ -93,7 +93,8 @@ pub struct Row {
     pub period_s: Option<f64>,
     /// Thornhill's regularity of the oscillation; `None` when there is no oscillation analysis.
     pub regularity: Option<f64>,
-    /// Why the verdict is what it is: the diagnosis' reason, else the indices' votes; for a
+    /// Why the verdict is what it is: the diagnosis' reasons in words (their `text`, which the
+    /// front end fills before building the row) joined by "; ", else the families' votes; for a
     /// failed loop the error.
     pub reason: String,
     /// Samples in the record; `None` for a failed loop.
@@ -106,7 +107,7 @@ pub struct Row {
 }
 
 /// The severity of a loop, the ranking key: the stiction band in % of valve span times the
-/// confidence for a `stiction` verdict, else 0 (never raw OP units: loops whose OP is scaled
+/// probability of a sticky valve for a `stiction` verdict, else 0 (never raw OP units: loops whose OP is scaled
 /// differently rank alike).
 ///
 /// The one place severity is defined: every ranking goes through here.
@@ -115,7 +116,7 @@ pub fn severity(d: &Diagnosis) -> f64 {
         return 0.0;
     }
     let band = d.band.as_ref().map_or(0.0, |b| b.band_percent_of_span);
-    band * d.confidence.unwrap_or(0.0)
+    band * d.probability.unwrap_or(0.0)
 }
 
 fn vote_name(v: Vote) -> &'static str {
@@ -155,7 +156,7 @@ impl Row {
             loop_id: loop_id.into(),
             source: source.into(),
             verdict: d.verdict.into(),
-            confidence: d.confidence,
+            probability: d.probability,
             severity: severity(d),
             band_percent_of_span: d.band.as_ref().map(|b| b.band_percent_of_span),
             band_source: d.band.as_ref().map(|b| b.source),
@@ -163,7 +164,19 @@ impl Row {
             small_band_percent_of_span: d.reach.as_ref().map(|r| r.small_band_percent_of_span),
             period_s: d.oscillation.as_ref().and_then(|o| o.period),
             regularity: d.oscillation.as_ref().map(|o| o.regularity.regularity),
-            reason: d.reason.clone().unwrap_or_else(|| votes(d)),
+            reason: {
+                let words: Vec<&str> = d
+                    .reasons
+                    .iter()
+                    .map(|r| r.text.as_str())
+                    .filter(|t| !t.is_empty())
+                    .collect();
+                if words.is_empty() {
+                    votes(d)
+                } else {
+                    words.join("; ")
+                }
+            },
             samples: Some(d.samples as u64),
             seconds: Some(d.seconds),
             error: String::new(),
@@ -177,7 +190,7 @@ impl Row {
             loop_id: loop_id.into(),
             source: source.into(),
             verdict: Outcome::Failed,
-            confidence: None,
+            probability: None,
             severity: 0.0,
             band_percent_of_span: None,
             band_source: None,

@@ -238,6 +238,7 @@ fn section(via_setpoint: bool, sets: &[Set], jsonl: &mut String) -> String {
                 match suite {
                     Suite::Routine => "routine",
                     Suite::Fast => "fast",
+                    Suite::Plant => "plant",
                 },
                 match set {
                     Set::Calibration => "calibration",

@@ -92,11 +92,7 @@ impl<'a> Beside<'a> {
             .and_then(|(_, l)| l.describing.as_ref())
             .map(|b| b.band);
         let self_sustained = basis.is_some_and(|(b, _)| b == StictionBasis::SelfSustained);
-        let levels = family(Family::Model)
-            .and_then(|f| f.model.as_ref())
-            .and_then(|m| m.levels.as_ref())
-            .filter(|l| l.sticky())
-            .map(|l| l.band);
+        let levels = None;
         let ellipse = (osc.oscillating)
             .then_some(osc.period)
             .flatten()

@@ -210,14 +210,14 @@ pub(super) fn op_outside_span(op: &[f64], req: &DiagnoseRequest) -> Option<Strin
 /// Why a stretch in which OP or PV never moves cannot be judged, and what to do: with OP still
 /// the controller did not act on the valve; with PV still nothing shows the loop's response (a
 /// frozen transmitter, or PV not recorded).
-pub(super) fn still(op: &[f64], pv: &[f64]) -> Option<(String, String)> {
+pub(super) fn still(op: &[f64], pv: &[f64]) -> Option<(String, super::Action)> {
     let constant = |x: &[f64]| x.first().filter(|&&v| x.iter().all(|&u| u == v)).copied();
     if let Some(v) = constant(op) {
         return Some((
             format!(
                 "OP stays at {v} over the whole analysed stretch: the controller did not move the valve (manual mode, or OP not recorded), so the record says nothing about the valve"
             ),
-            "use a record in automatic, with OP as the controller wrote it".into(),
+            super::Action::UsableRecord,
         ));
     }
     constant(pv).map(|v| {
@@ -225,7 +225,7 @@ pub(super) fn still(op: &[f64], pv: &[f64]) -> Option<(String, String)> {
             format!(
                 "PV stays at {v} over the whole analysed stretch while OP moves: a frozen transmitter or a PV not recorded, so nothing shows how the loop responds to the valve"
             ),
-            "check the PV transmitter and its historian tag, then judge a record in which PV moves".into(),
+            super::Action::CheckTransmitter,
         )
     })
 }

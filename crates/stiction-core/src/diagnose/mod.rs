@@ -1,50 +1,55 @@
 //! Diagnosing a loop from routine data, as a control engineer does: which samples can be judged
 //! (automatic mode, every signal present, OP off its limits; setpoint changes are kept, they are
-//! the best excitation a loop gets), then independent families of evidence, each with its value,
-//! threshold and vote, and a verdict that says why.
+//! the best excitation a loop gets), then independent families of evidence, each measuring what
+//! it can, and one calibrated model that reads their statistics and gives the probability of a
+//! sticky valve.
 //!
 //! - `bridge`, `stretch` and `gates`: short gaps bridged, the usable stretches and the
 //!   data-quality findings;
 //! - [`oscillation`]: does the loop oscillate (for the shape family);
 //! - [`evidence`]: the families (valve, model, stick-slip, shape, loop and, with `thorough`, the
 //!   hidden valve), one file each behind a trait;
-//! - `verdict`: families that agree decide, families that conflict give `undetermined`;
+//! - `verdict`: the model ([`VerdictModel`]), the verdict from its probability, and the reasons
+//!   and next step as typed values ([`reasons`]);
+//! - [`Settings`]: how the families measure, one checked table;
 //! - `band`: when the verdict is `stiction`, the band in % of valve span and where it comes from;
 //! - [`reach`]: the bands a record like this one shows and hides, from OP's noise;
-//! - [`Thresholds`]: the families' thresholds as one table, for studies and tests;
 //! - `windows`: the same judgement per window of the record.
 
 mod band;
 mod bridge;
-pub mod combined;
 pub mod evidence;
 mod gates;
 pub mod oscillation;
 pub mod reach;
+pub mod reasons;
 mod request;
 mod result;
-mod saturation;
 pub mod setpoint;
+mod settings;
 mod stretch;
-mod thresholds;
 mod verdict;
 mod windows;
 
 pub use evidence::{Family, FamilyEvidence};
 pub use oscillation::noise_std;
 pub use reach::Reach;
+pub use reasons::{Action, Finding, NextStep, Reason};
 pub use request::{DiagnoseError, DiagnoseRequest};
 pub use result::{
     Band, BandSource, Diagnosis, Index, Oscillation, SetpointReadOff, Verdict, Vote, WindowVerdict,
 };
-pub use thresholds::Thresholds;
+pub use settings::Settings;
+pub use verdict::{
+    Contribution, Input, ModelError, Reading, Statistic, Training, VerdictModel, VOTE,
+};
 
 /// The signals of one loop record (op, pv, and when recorded sp, mv, time in seconds, and
 /// `auto`: `true` where the controller is in automatic). Missing values are NaN.
 pub use crate::quality::Record as LoopRecord;
 
 use crate::checked::Checked;
-use crate::quality::{self, Finding, Gate};
+use crate::quality::{self, Finding as GateFinding, Gate};
 use crate::quantify::CompareRequest;
 use evidence::Context;
 use oscillation::mean;
@@ -57,8 +62,6 @@ struct Judged {
     indices: Vec<Index>,
     oscillation: Osc,
     decision: verdict::Decision,
-    /// The families' statistics read together ([`combined`]).
-    combined: Option<combined::CombinedEvidence>,
     fits: Option<crate::quantify::FitComparison>,
     /// Without a recorded setpoint, the setpoint read off OP and PV ([`setpoint`]).
     setpoint: Option<setpoint::Inferred>,
@@ -111,40 +114,20 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
     };
     let mut families: Vec<FamilyEvidence> =
         evidence::all().iter().map(|f| f.evaluate(&ctx)).collect();
-    let motion = verdict::Motion::of(&ctx.oscillation, req.ts, sp).with_pv_not_recorded(
-        ctx.unrecorded_share(0, r.pv.len()),
-        req.limits.repeated_share,
-    );
-    let mut decision = verdict::decide(&families, &motion);
-    // the hidden valve costs seconds: only with `thorough`, only where it can change the verdict
+    // the hidden valve costs seconds: only with `thorough`; it reports, the model does not read it
     if req.thorough {
-        if decision.verdict == Verdict::Stiction {
-            families.push(evidence::hidden_valve::not_needed());
-        } else {
-            families.push(evidence::EvidenceFamily::evaluate(
-                &evidence::hidden_valve::HiddenValve,
-                &ctx,
-            ));
-            decision = verdict::decide(&families, &motion);
-        }
+        families.push(evidence::EvidenceFamily::evaluate(
+            &evidence::hidden_valve::HiddenValve,
+            &ctx,
+        ));
     }
-    let mut combined = combined::CombinedEvidence::of(&combined::features::Stretch {
-        families: &families,
-        oscillation: &ctx.oscillation,
-        indices: ctx.indices.get().map_or(&[], Vec::as_slice),
-        op_noise: reach::op_noise(&families, || ctx.op_noise),
-        ts: req.ts,
-        samples: r.op.len(),
-    });
-    if let Some(c) = combined.as_mut() {
-        c.for_verdict(decision.verdict);
-        if c.decides(decision.verdict, &families) {
-            c.decided = true;
-            c.before = Some(decision.verdict);
-            decision = verdict::decided_by_combination(decision, c, &families, &motion);
-        }
-        decision.evidence.push(c.line());
-    }
+    let motion = verdict::Motion::of(&ctx.oscillation, req.ts, sp, r.op.len())
+        .with_pv_not_recorded(
+            ctx.unrecorded_share(0, r.pv.len()),
+            req.limits.repeated_share,
+        );
+    let measured = verdict::Measured::of(&families, reach::op_noise(&families, || ctx.op_noise));
+    let decision = verdict::decide(&mut families, &measured, &motion);
     let Context {
         oscillation,
         indices,
@@ -156,7 +139,6 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         indices: indices.into_inner().unwrap_or_default(),
         oscillation,
         decision,
-        combined,
         fits,
         setpoint: inferred,
     }
@@ -235,10 +217,10 @@ pub fn diagnose_checked(
         .map_or_else(Vec::new, |w| windows::judge_windows(r, req, w, judge));
     let mut d = Diagnosis {
         verdict: Verdict::InsufficientData,
-        confidence: None,
-        reason: None,
-        evidence: Vec::new(),
-        next_step: String::new(),
+        probability: None,
+        reasons: Vec::new(),
+        next_step: NextStep::plain(Action::UsableRecord),
+        statistics: None,
         samples: n,
         analysed: [s, e],
         stretches: stretches.iter().map(|&(a, b)| [a, b]).collect(),
@@ -246,7 +228,6 @@ pub fn diagnose_checked(
         quality,
         oscillation: None,
         families: Vec::new(),
-        combined: None,
         indices: Vec::new(),
         reach: None,
         band: None,
@@ -258,16 +239,12 @@ pub fn diagnose_checked(
         seconds: 0.0,
     };
     if e - s < req.min_samples {
-        if let Some((family, osc)) = saturation::bounded(r, req, e - s) {
-            return Ok(saturation_bound(d, family, osc, r.sp, req, started));
-        }
         let reason = too_short(&d.quality, e - s, req);
-        let next_step = "use a longer record in automatic with every signal present".into();
-        return Ok(unjudged(d, reason, next_step, started));
+        return Ok(unjudged(d, reason, Action::UsableRecord, started));
     }
     let sub = r.slice(s, e);
-    if let Some((reason, next_step)) = gates::still(sub.op, sub.pv) {
-        return Ok(unjudged(d, reason, next_step, started));
+    if let Some((reason, action)) = gates::still(sub.op, sub.pv) {
+        return Ok(unjudged(d, reason, action, started));
     }
     let j = judge(&sub, req);
     if let Some(read) = &j.setpoint {
@@ -277,12 +254,11 @@ pub fn diagnose_checked(
         d.setpoint_read_off = Some(read.in_record(s));
     }
     d.verdict = j.decision.verdict;
-    d.confidence = j.decision.confidence;
-    d.reason = j.decision.reason;
-    d.evidence = j.decision.evidence;
+    d.probability = j.decision.probability;
+    d.reasons = j.decision.reasons;
     d.next_step = j.decision.next_step;
+    d.statistics = j.decision.reading;
     d.families = j.families;
-    d.combined = j.combined;
     d.indices = j.indices;
     d.reach = reach::of(&d, sub.op, req);
     let mut osc = j.oscillation;
@@ -295,58 +271,16 @@ pub fn diagnose_checked(
     Ok(d)
 }
 
-/// `d` judged on the loop family's saturation rule alone, over the whole record
-/// ([`saturation::bounded`]).
-fn saturation_bound(
-    mut d: Diagnosis,
-    family: FamilyEvidence,
-    osc: Osc,
-    sp: Option<&[f64]>,
-    req: &DiagnoseRequest,
-    started: Instant,
-) -> Diagnosis {
-    let families = vec![family];
-    let decision = verdict::decide(&families, &verdict::Motion::of(&osc, req.ts, sp));
-    d.verdict = decision.verdict;
-    d.confidence = decision.confidence;
-    d.reason = decision.reason;
-    d.evidence = decision.evidence;
-    d.next_step = decision.next_step;
-    d.families = families;
-    d.oscillation = Some(osc);
-    let [s, e] = d.analysed;
-    for f in d
-        .quality
-        .iter_mut()
-        .filter(|f| f.gate == Gate::RecordLength)
-    {
-        f.message = format!(
-            "the longest usable stretch, samples {s} to {e}, is too short for the families ({} of {} samples, of {} usable stretches); the whole record was read for OP's saturation",
-            e - s,
-            d.samples,
-            d.stretches.len()
-        );
-    }
-    d.warnings.push(format!(
-        "OP's limits cut the record into stretches too short to judge the valve (the longest {} samples): only the saturation was judged, over the whole record",
-        e - s
-    ));
-    d.analysed = [0, d.samples];
-    d.seconds = started.elapsed().as_secs_f64();
-    d
-}
-
 /// `d` as `insufficient_data` (its default verdict) for `reason`, with the next step.
-fn unjudged(mut d: Diagnosis, reason: String, next_step: String, started: Instant) -> Diagnosis {
-    d.evidence = vec![reason.clone()];
-    d.reason = Some(reason);
-    d.next_step = next_step;
+fn unjudged(mut d: Diagnosis, reason: String, action: Action, started: Instant) -> Diagnosis {
+    d.reasons = vec![Reason::plain(reasons::Finding::Record { message: reason })];
+    d.next_step = NextStep::plain(action);
     d.seconds = started.elapsed().as_secs_f64();
     d
 }
 
 /// Why a record too short to judge is so.
-fn too_short(quality: &[Finding], used: usize, req: &DiagnoseRequest) -> String {
+fn too_short(quality: &[GateFinding], used: usize, req: &DiagnoseRequest) -> String {
     let left: Vec<&str> = quality
         .iter()
         .filter(|f| !f.passed && !matches!(f.gate, Gate::RecordLength | Gate::PvQuantised))

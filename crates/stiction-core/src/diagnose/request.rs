@@ -40,6 +40,9 @@ pub struct DiagnoseRequest {
     /// where it votes stiction: a vote is the median of three draws of its particle filter).
     #[serde(default)]
     pub thorough: bool,
+    /// How the families measure ([`super::Settings`]).
+    #[serde(default)]
+    pub settings: super::Settings,
 }
 
 fn default_op_range() -> [f64; 2] {
@@ -61,6 +64,7 @@ impl Default for DiagnoseRequest {
             verdict_margin: 0.3,
             op_range: default_op_range(),
             thorough: false,
+            settings: super::Settings::default(),
         }
     }
 }
@@ -137,7 +141,8 @@ impl DiagnoseRequest {
             "limits.gap_steps",
             "a finite number > 0",
             l.gap_steps,
-        )
+        )?;
+        self.settings.check()
     }
 
     /// A band in OP units as a percentage of the valve's span.

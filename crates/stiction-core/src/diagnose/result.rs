@@ -217,11 +217,11 @@ pub struct WindowVerdict {
     pub t_end: f64,
     /// The window's verdict.
     pub verdict: Verdict,
-    /// 0..1, for `stiction` and `no_stiction` only (as [`Diagnosis::confidence`]).
+    /// The probability of a sticky valve (as [`Diagnosis::probability`]).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub confidence: Option<f64>,
-    /// For `insufficient_data` and `undetermined`: the reason.
-    pub reason: Option<String>,
+    pub probability: Option<f64>,
+    /// Why (as [`Diagnosis::reasons`]).
+    pub reasons: Vec<super::Reason>,
     /// The oscillation period, seconds, when the window oscillates.
     pub period: Option<f64>,
     /// Each family's vote.
@@ -252,17 +252,18 @@ impl SetpointReadOff {
 pub struct Diagnosis {
     /// The answer for the loop.
     pub verdict: Verdict,
-    /// 0..1, for `stiction` and `no_stiction` only: how strongly the families that decided agree.
+    /// The probability of a sticky valve from the verdict's model (`None` where the record could
+    /// not be judged).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub confidence: Option<f64>,
-    /// For `insufficient_data` and `undetermined`: the reason (for a conflict, the families that
-    /// disagree).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub reason: Option<String>,
-    /// The findings behind the verdict, in words.
-    pub evidence: Vec<String>,
-    /// What to do next, in one line.
-    pub next_step: String,
+    pub probability: Option<f64>,
+    /// Why: the one or two findings that decided the verdict (for `insufficient_data`, why the
+    /// record cannot be judged; for `undetermined`, the probability between the thresholds).
+    pub reasons: Vec<super::Reason>,
+    /// What to do next.
+    pub next_step: super::NextStep,
+    /// The verdict's model's reading: each statistic's value and its share of the log-odds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub statistics: Option<super::Reading>,
     /// Samples in the record.
     pub samples: usize,
     /// The analysed stretch `[start, end)`: the longest stretch in automatic with usable data
@@ -277,12 +278,9 @@ pub struct Diagnosis {
     /// The oscillation on the analysed stretch (absent when the record is too short to judge).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub oscillation: Option<Oscillation>,
-    /// The families of evidence, each with its value, threshold and vote.
+    /// The families of evidence, each with what it measured and its vote (its statistics'
+    /// share of the model's log-odds).
     pub families: Vec<FamilyEvidence>,
-    /// The families' statistics read together (trained trees; they only ever add a `stiction`
-    /// verdict): absent on a record too short or too still to judge.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub combined: Option<super::combined::CombinedEvidence>,
     /// The shape family's indices (on an oscillating stretch).
     pub indices: Vec<Index>,
     /// The bands a record like this one shows and hides, from OP's noise (on every judged

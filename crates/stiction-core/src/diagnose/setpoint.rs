@@ -12,11 +12,8 @@
 //! settled level differs from its settled level before by more than its noise allows, is taken
 //! as a setpoint step, and the setpoint between such steps as PV's settled level there.
 
-use super::evidence::model::robust_sd;
-
-/// An OP step: an increment beyond this many standard deviations of OP's increments, as for the
-/// unprovoked steps ([`super::evidence::model::STEP_SIGMAS`]).
-const STEP_SIGMAS: f64 = super::evidence::model::STEP_SIGMAS;
+/// An OP step: an increment beyond this many standard deviations of OP's increments.
+const STEP_SIGMAS: f64 = 6.0;
 /// PV still at the step: its change over the samples before the step and the step's own within
 /// this many of PV's noise standard deviations (a valve's slip moves PV by many more before OP
 /// answers it). Set on the catalogue's calibration sets judged without SP (`plant_benchmark
@@ -157,6 +154,17 @@ fn settled_levels(pv: &[f64], n: usize, steps: &[usize]) -> Vec<f64> {
             *v.select_nth_unstable_by(mid, f64::total_cmp).1
         })
         .collect()
+}
+
+/// 1.4826 times the median absolute deviation of `x` from its median (0 when empty).
+fn robust_sd(mut x: Vec<f64>) -> f64 {
+    if x.is_empty() {
+        return 0.0;
+    }
+    let mid = x.len() / 2;
+    let median = *x.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let mut dev: Vec<f64> = x.iter().map(|v| (v - median).abs()).collect();
+    1.4826 * *dev.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 #[cfg(test)]

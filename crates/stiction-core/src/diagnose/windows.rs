@@ -1,6 +1,7 @@
 //! The same judgement per window of the record: each window's longest usable stretch is judged by
 //! the same families as the whole record.
 
+use super::reasons::{Finding, Reason};
 use super::request::DiagnoseRequest;
 use super::result::{Verdict, WindowVerdict};
 use super::{stretch, Judged, LoopRecord};
@@ -34,36 +35,24 @@ pub(super) fn judge_windows(
             t_start: t(start),
             t_end: t(end - 1),
             verdict: Verdict::InsufficientData,
-            confidence: None,
-            reason: Some(format!(
+            probability: None,
+            reasons: vec![record(format!(
                 "the longest usable stretch has {} samples; a verdict needs at least {}",
                 e - s,
                 req.min_samples
-            )),
+            ))],
             period: None,
             votes: Vec::new(),
         };
-        if e - s < req.min_samples {
-            // OP's limits cut the window short: the loop family's saturation rule over it
-            if let Some((family, osc)) = super::saturation::bounded(&sub, req, e - s) {
-                let families = [family];
-                let motion = super::verdict::Motion::of(&osc, req.ts, sub.sp);
-                let decision = super::verdict::decide(&families, &motion);
-                v.verdict = decision.verdict;
-                v.confidence = decision.confidence;
-                v.reason = decision.reason;
-                v.period = osc.period;
-                v.votes = families.iter().map(|f| (f.family, f.vote)).collect();
-            }
-        } else {
+        if e - s >= req.min_samples {
             let judged = sub.slice(s, e);
             match super::gates::still(judged.op, judged.pv) {
-                Some((reason, _)) => v.reason = Some(reason),
+                Some((reason, _)) => v.reasons = vec![record(reason)],
                 None => {
                     let j = judge(&judged, req);
                     v.verdict = j.decision.verdict;
-                    v.confidence = j.decision.confidence;
-                    v.reason = j.decision.reason;
+                    v.probability = j.decision.probability;
+                    v.reasons = j.decision.reasons;
                     v.period = j
                         .oscillation
                         .oscillating
@@ -77,4 +66,8 @@ pub(super) fn judge_windows(
         start = end;
     }
     out
+}
+
+fn record(message: String) -> Reason {
+    Reason::plain(Finding::Record { message })
 }

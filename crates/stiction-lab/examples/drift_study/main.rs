@@ -32,6 +32,7 @@ struct Judged {
 fn judge(l: &BenchmarkLoop, full: bool) -> Judged {
     let group = match (l.suite, l.ts() < 5.0) {
         (Suite::Fast, _) => "fast",
+        (Suite::Plant, _) => "plant windows",
         (Suite::Routine, true) => "routine, 1 s",
         (Suite::Routine, false) => "routine, 10 s",
     };

@@ -77,7 +77,7 @@ fn fail(msg: &str) -> ! {
 fn options() -> Options {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut o = Options {
-        suites: vec![Suite::Routine, Suite::Fast],
+        suites: vec![Suite::Routine, Suite::Fast, Suite::Plant],
         set: Set::Benchmark,
         only: None,
         out: None,
@@ -98,8 +98,9 @@ fn options() -> Options {
                 o.suites = match value(i, flag).as_str() {
                     "routine" => vec![Suite::Routine],
                     "fast" => vec![Suite::Fast],
-                    "all" => vec![Suite::Routine, Suite::Fast],
-                    other => fail(&format!("--set {other}: use routine, fast or all")),
+                    "plant" => vec![Suite::Plant],
+                    "all" => vec![Suite::Routine, Suite::Fast, Suite::Plant],
+                    other => fail(&format!("--set {other}: use routine, fast, plant or all")),
                 }
             }
             "--only" => {
@@ -250,6 +251,9 @@ fn suite_title(suite: Suite) -> &'static str {
     match suite {
         Suite::Routine => "Routine plant historian windows (issue 10)",
         Suite::Fast => "Fast loops that limit-cycle (issue 14)",
+        Suite::Plant => {
+            "Plant windows (10-s averages of a 1-s loop, detuned PI, operator setpoint steps)"
+        }
     }
 }
 

@@ -192,6 +192,7 @@ pub fn suite(md: &mut String, suite: Suite, cal: &[Judged], bench: &[Judged]) {
         match suite {
             Suite::Routine => "Routine plant historian windows (issue 10)",
             Suite::Fast => "Fast loops that limit-cycle (issue 14)",
+            Suite::Plant => "Plant windows (10-s averages of a 1-s loop, detuned PI)",
         },
         100.0 * ours_rate,
         cal_ns.len(),

@@ -292,6 +292,10 @@ pub struct BenchmarkLoop {
     pub attempts: u64,
     /// The cycle the same loop keeps without measurement noise, if any.
     pub cycle: Option<Cycle>,
+    /// A sticky valve's slip visibility: how far its slips move PV, in the recorded PV's noise
+    /// standard deviations (`plant::slip_visibility`); `None` for other valves.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub visibility: Option<f64>,
     /// The record: t, sp, op, mv, pv.
     pub data: LoopData,
 }
@@ -303,7 +307,7 @@ impl BenchmarkLoop {
     }
 }
 
-/// A cycle of the control error (see `cycle_without_noise` in the catalogue's sources).
+/// A cycle of the control error (see `cycle_of` in the catalogue's sources).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Cycle {
     /// Mean period, seconds.

@@ -1,7 +1,7 @@
 //! The catalogue of benchmark loops: simulated plant loops of many kinds, each with its truth
 //! (sticky valve, healthy valve, backlash only), to calibrate and check `diagnose`.
 //!
-//! Two suites, after the benchmark parts of issues 10 and 14:
+//! Three suites, after the benchmark parts of issues 10, 14 and 69:
 //! - [`Suite::Routine`] (540 loops): routine plant historian windows, 750 samples every 10 s or
 //!   2,000 every 1 s, of flow, pressure, level (integrating) and temperature or analyser loops
 //!   under SIMC (lambda) tuning, excited by setpoint step sequences, slow load drifts and load
@@ -13,6 +13,14 @@
 //!   every 1-3 s, samples every 1-5 s, actuator lag, bands 0.5-5 %; look-alikes: an external
 //!   oscillation at the loop's own period, tuning at the stability limit, OP saturating at 0 or
 //!   100 %, a cascade's inner loop; and the example of issue 14 ([`issue14_example`]).
+//! - [`Suite::Plant`] (430 loops): plant historian windows shaped after the real plant records
+//!   (`../shared/data/plant-dev`): 750 values 10 s apart, each the mean of a 1-s loop's values;
+//!   flow, level and pressure loops (and slow temperature or analyser look-alikes) under detuned
+//!   PI (integral times many time constants: a stuck valve's OP winds for tens of minutes);
+//!   operator setpoint steps and staircases; bands 0.3-4 %; look-alikes: levels and flows near
+//!   their stability limit, external oscillations, load steps, load steps fed forward. A sticky
+//!   valve needs one slip, and carries its visibility (how far its slips move PV, in noise
+//!   standard deviations: `BenchmarkLoop::visibility`).
 //!
 //! Each suite has two sets drawn from the same ranges: [`Set::Benchmark`] with fixed seeds (the
 //! figures we report) and [`Set::Calibration`] with other seeds, for setting thresholds, so the
@@ -33,6 +41,7 @@ mod kinds;
 mod plant;
 mod routine;
 mod tuning;
+mod windows;
 
 pub use fast::issue14_example;
 pub use kinds::{BenchmarkLoop, Cycle, Excitation, LoopClass, LoopKind, NoiseLevel, Truth, Tuning};
@@ -54,6 +63,9 @@ pub enum Suite {
     Routine,
     /// Fast limit-cycling loops (issue 14).
     Fast,
+    /// Plant historian windows as the real plant records are (`windows`): 10-s averages of a
+    /// 1-s loop, detuned PI, operator setpoint steps, levels near their stability limit.
+    Plant,
 }
 
 /// Which seeds: the reported benchmark or the calibration set.
@@ -98,6 +110,17 @@ pub fn plan(suite: Suite) -> &'static [(LoopClass, usize)] {
             (SaturatedOp, 30),
             (CascadeInner, 30),
         ],
+        Suite::Plant => &[
+            (StenmanValve, 60),
+            (KanoValve, 60),
+            (HeValve, 60),
+            (Healthy, 80),
+            (NearUnstable, 40),
+            (ExternalOscillation, 30),
+            (LoadSteps, 30),
+            (FeedForward, 20),
+            (SlowLongDelay, 30),
+        ],
     }
 }
 
@@ -110,6 +133,9 @@ pub fn set_seed(suite: Suite, set: Set) -> u64 {
         (Suite::Fast, Set::Calibration) => 90_261_114,
         (Suite::Routine, Set::Extra(n)) => 40_261_110 + 100_000 * u64::from(n),
         (Suite::Fast, Set::Extra(n)) => 40_261_114 + 100_000 * u64::from(n),
+        (Suite::Plant, Set::Benchmark) => 20_261_202,
+        (Suite::Plant, Set::Calibration) => 90_261_202,
+        (Suite::Plant, Set::Extra(n)) => 40_261_202 + 100_000 * u64::from(n),
     }
 }
 
@@ -134,6 +160,7 @@ pub fn loop_id(suite: Suite, set: Set, index: usize) -> String {
     let s = match suite {
         Suite::Routine => "routine",
         Suite::Fast => "fast",
+        Suite::Plant => "plant",
     };
     match set {
         Set::Benchmark => format!("{s}-b-{index:04}"),
@@ -150,6 +177,7 @@ pub fn generate(suite: Suite, set: Set, index: usize) -> Option<BenchmarkLoop> {
     let mut l = match suite {
         Suite::Routine => plant::with_slips(class, seed, plant::Accept::Slips, routine::build),
         Suite::Fast => plant::with_slips(class, seed, plant::Accept::SlipsAndCycle, fast::build),
+        Suite::Plant => plant::with_slips(class, seed, plant::Accept::AnySlip, windows::build),
     };
     l.id = id;
     l.suite = suite;
@@ -175,6 +203,7 @@ pub fn find(id: &str) -> Option<BenchmarkLoop> {
     let suite = match parts.next()? {
         "routine" => Suite::Routine,
         "fast" => Suite::Fast,
+        "plant" => Suite::Plant,
         _ => return None,
     };
     let set = match parts.next()? {

@@ -15,13 +15,15 @@
 //! sets has such a step). It votes stiction or not at all: a sticky valve's ratio can be small, so
 //! a small ratio is no evidence against it.
 
-use super::model::{unprovoked, Unprovoked};
+#[path = "hidden_valve_unprovoked.rs"]
+mod unprovoked_steps;
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
 use crate::diagnose::oscillation::amplitude;
 use crate::diagnose::result::Vote;
 use crate::hidden_valve::{test, HiddenValveTest, Particles, Record, TestSettings};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use unprovoked_steps::{unprovoked, Unprovoked};
 
 /// The hidden-valve family.
 pub struct HiddenValve;

@@ -80,8 +80,13 @@ pub struct FamilyEvidence {
     pub family: Family,
     /// Its vote.
     pub vote: Vote,
-    /// 0..1: how strongly the evidence holds the vote (1: decisive; for `undetermined`, 0).
+    /// 0..1: how strongly the evidence holds the vote, `1 - exp(-|contribution|)` (for
+    /// `undetermined`, 0).
     pub strength: f64,
+    /// The family's statistics' share of the verdict's log-odds (positive: towards a sticky
+    /// valve); `None` where the model reads none of them here.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contribution: Option<f64>,
     /// The family's statistic.
     pub value: Option<f64>,
     /// What the statistic is, in words.
@@ -119,6 +124,7 @@ impl FamilyEvidence {
             family,
             vote: Vote::Undetermined,
             strength: 0.0,
+            contribution: None,
             value: None,
             statistic: statistic.into(),
             threshold,

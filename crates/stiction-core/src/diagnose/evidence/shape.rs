@@ -111,6 +111,7 @@ impl EvidenceFamily for Shape {
                 Vote::NoStiction => AGAINST_STRENGTH * support,
                 Vote::Undetermined => 0.0,
             },
+            contribution: None,
             value: Some(score),
             statistic: statistic.into(),
             threshold,

@@ -127,6 +127,7 @@ impl EvidenceFamily for Valve {
             family: Family::Valve,
             vote,
             strength,
+            contribution: None,
             value: Some(pct),
             statistic: statistic.into(),
             threshold,

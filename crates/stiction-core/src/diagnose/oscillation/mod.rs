@@ -4,7 +4,10 @@
 
 use super::result::Oscillation;
 use crate::detect::{self, IaeSettings};
-use crate::diagnose::evidence::model::FORCED_REGULARITY;
+
+/// Thornhill's regularity from which a cycle keeps time like an input of fixed period (a weak
+/// cycle that regular is no limit cycle).
+const FORCED_REGULARITY: f64 = 100.0;
 
 pub(crate) fn mean(x: &[f64]) -> f64 {
     x.iter().sum::<f64>() / x.len().max(1) as f64

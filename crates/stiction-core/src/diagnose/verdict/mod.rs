@@ -1,169 +1,70 @@
-//! The verdict from the families: families that agree give `stiction` or `no_stiction` with a
-//! confidence; families that conflict give `undetermined`, naming the conflict. The valve family
-//! (the recorded valve position) outweighs the indirect ones, then the hidden valve's stiction
-//! vote (with `thorough`). Against the loop family's evidence
-//! of a non-linearity, the shape, fit and stick-slip votes against stiction count only weakly.
-//! A family whose statistic lies between its thresholds casts no vote but says which way it
-//! leans: with no vote cast, such a record is `undetermined` (judged, too weak to decide), not
-//! `insufficient_data` (nothing could be judged).
+//! The verdict: one calibrated model reads a few statistics the families measure and gives the
+//! probability of a sticky valve ([`model`]); the verdict is `stiction` from the model's upper
+//! threshold, `no_stiction` under its lower one, `undetermined` between. Where the valve position
+//! is recorded its family decides (it measures the valve itself). Each family's vote is what its
+//! statistics did to the log-odds: towards a sticky valve by at least [`VOTE`], or not. No rule
+//! overrides the model, and no family reads another's result.
+
+mod model;
+mod statistics;
+
+pub use model::{Contribution, Input, ModelError, Reading, Statistic, Training, VerdictModel};
+pub(super) use statistics::Measured;
 
 use super::evidence::{Family, FamilyEvidence};
+use super::reasons::{Action, Finding, NextStep, Reason};
 use super::result::{Verdict, Vote};
 
-mod next_step;
-use next_step::next_step;
-pub(super) use next_step::op_does_not_drive;
+/// A family whose statistics move the log-odds towards a sticky valve by at least this much
+/// votes stiction (a factor of about 1.6 on the odds); measured and short of it, no stiction.
+pub const VOTE: f64 = 0.5;
+/// At most this many findings are named as the verdict's reasons.
+const NAMED: usize = 2;
 
-/// What the families decide.
+/// What the verdict decides.
 pub(super) struct Decision {
     pub verdict: Verdict,
-    pub confidence: Option<f64>,
-    pub reason: Option<String>,
-    pub evidence: Vec<String>,
-    pub next_step: String,
+    pub probability: Option<f64>,
+    pub reading: Option<Reading>,
+    pub reasons: Vec<Reason>,
+    pub next_step: NextStep,
 }
 
-/// A side of a conflict wins when its total strength is at least this many times the other's and
-/// no single vote against it is stronger than `WEAK_DISSENT`.
-const DOMINANCE: f64 = 1.0;
-pub(super) const WEAK_DISSENT: f64 = 0.5;
-/// A stiction verdict needs at least one vote this strong.
-const DECIDES: f64 = 0.5;
-
-/// Against the loop family's evidence of a non-linearity that sustains the cycle, a vote against
-/// stiction that reads the cycle's shape or a fit (shape, model, stick-slip) counts at most this:
-/// a fast loop's valve can stick for less than a sample, which leaves the cycle near-sinusoidal,
-/// the fits with and without a band alike and no stick-slip episode to find (detection.md, "A
-/// limit cycle that no linear loop can sustain").
-const BLIND_AGAINST_LOOP: f64 = 0.15;
-
-/// A vote's strength in the verdict: its own, unless it is one of the votes against stiction
-/// that held loop evidence for it (`loop_holds`: a stiction vote of strength 0.5 or more)
-/// outweighs. Weaker loop evidence (no setpoint recorded) only keeps them from deciding.
-fn weight(f: &FamilyEvidence, loop_holds: bool) -> f64 {
-    let blind = matches!(f.family, Family::Shape | Family::Model | Family::StickSlip);
-    if loop_holds && blind && f.vote == Vote::NoStiction {
-        f.strength.min(BLIND_AGAINST_LOOP)
-    } else {
-        f.strength
-    }
-}
-
-/// Independent evidence: the chance that every supporting family is wrong, taken as the product.
-fn combined(strengths: impl Iterator<Item = f64>) -> f64 {
-    1.0 - strengths.fold(1.0, |p, s| p * (1.0 - s.clamp(0.0, 0.99)))
-}
-
-fn names(fams: &[&FamilyEvidence]) -> String {
-    let words: Vec<&str> = fams.iter().map(|f| f.family.words()).collect();
-    match words.as_slice() {
-        [] => String::new(),
-        [one] => one.to_string(),
-        [init @ .., last] => format!("{} and {last}", init.join(", ")),
-    }
-}
-
-/// One line per family: its name, vote and note.
-fn evidence_lines(families: &[FamilyEvidence]) -> Vec<String> {
-    families
-        .iter()
-        .map(|f| {
-            format!(
-                "{}: {} ({})",
-                f.family.words(),
-                match f.vote {
-                    Vote::Stiction => "stiction",
-                    Vote::NoStiction => "no stiction",
-                    Vote::Undetermined => "undetermined",
-                },
-                f.note
-            )
-        })
-        .collect()
-}
-
-/// The recorded valve position decides when its family votes: the verdict, and a confidence
-/// from 0.8 (every other voting family against) to 1 (all agree).
-fn by_valve(families: &[FamilyEvidence]) -> Option<(Verdict, f64)> {
-    let valve = families
-        .iter()
-        .find(|f| f.family == Family::Valve && f.vote != Vote::Undetermined)?;
-    let others: Vec<&FamilyEvidence> = families
-        .iter()
-        .filter(|f| f.family != Family::Valve && f.vote != Vote::Undetermined)
-        .collect();
-    let agree = others.iter().filter(|f| f.vote == valve.vote).count();
-    let share = if others.is_empty() {
-        1.0
-    } else {
-        agree as f64 / others.len() as f64
-    };
-    let verdict = if valve.vote == Vote::Stiction {
-        Verdict::Stiction
-    } else {
-        Verdict::NoStiction
-    };
-    Some((verdict, 0.8 + 0.2 * share))
-}
-
-/// The hidden-valve family's stiction vote decides (its threshold lies above every look-alike of
-/// the calibration sets, and the families it overrules read the recorded OP as the valve's input,
-/// which is what it shows to be wrong): the confidence, from 0.6 (every other voting family
-/// against) to 0.9 (all agree).
-fn by_hidden_valve(families: &[FamilyEvidence]) -> Option<f64> {
-    families
-        .iter()
-        .find(|f| f.family == Family::HiddenValve && f.vote == Vote::Stiction)?;
-    let others: Vec<&FamilyEvidence> = families
-        .iter()
-        .filter(|f| f.family != Family::HiddenValve && f.vote != Vote::Undetermined)
-        .collect();
-    let agree = others.iter().filter(|f| f.vote == Vote::Stiction).count();
-    let share = if others.is_empty() {
-        1.0
-    } else {
-        agree as f64 / others.len() as f64
-    };
-    Some(0.6 + 0.3 * share)
-}
-
-/// What the oscillation tells a verdict that no family could judge.
+/// What the oscillation and the record tell a verdict besides the statistics.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Motion {
-    /// The loop oscillates, so a record no family could judge is not short of excitation.
-    pub oscillating: bool,
     /// A regular cycle too short in samples for any family (its period, s, and samples per
-    /// period): the control error's autocorrelation shows it, but at a few samples a cycle it
-    /// passes for measurement noise.
+    /// period): at a few samples a cycle passes for measurement noise.
     pub unresolved_cycle: Option<(f64, f64)>,
-    /// The setpoint is recorded and holds over the whole stretch: nothing but the load and the
-    /// noise moves the loop, and the fits must tell the process from the load in closed loop
-    /// (on the plant benchmark a sticky valve is called `stiction` in 26-50 % of such windows,
-    /// 61-76 % of those with setpoint steps).
+    /// The setpoint is recorded and holds over the whole stretch.
     pub setpoint_steady: bool,
-    /// The share of PV samples that look not recorded (historian compression or a frozen
-    /// transmitter), when over the quality gate's limit ([`crate::quality::Limits`]'s
-    /// `repeated_share`): compression hides a sticky valve's sticks, which the next step says.
+    /// The share of PV samples that look not recorded, when over the quality gate's limit.
     pub pv_not_recorded: Option<f64>,
+    /// The oscillation's period, seconds, when the loop oscillates.
+    pub period: Option<f64>,
+    /// The analysed stretch, minutes.
+    pub minutes: f64,
+    /// Sampling time, seconds.
+    pub ts: f64,
 }
 
 /// Thornhill's regularity from which a cycle of under [`UNRESOLVED_SAMPLES`] samples a period is
-/// named in an `insufficient_data` reason. On the plant benchmark such cycles (regularity 5 to
-/// 40) are sticky valves' limit cycles recorded every 10 s and loops tuned at their stability
-/// limit, which the record is sampled too slowly to tell apart.
+/// named as unresolved.
 const UNRESOLVED_REGULARITY: f64 = 5.0;
 /// A cycle of fewer samples than this a period is not resolved.
 const UNRESOLVED_SAMPLES: f64 = 4.0;
 
 impl Motion {
-    /// From the oscillation of the analysed stretch, sampled every `ts` seconds, and its
-    /// setpoint when recorded.
-    pub fn of(osc: &super::Oscillation, ts: f64, sp: Option<&[f64]>) -> Self {
+    /// From the oscillation of the analysed stretch of `samples`, sampled every `ts` seconds,
+    /// and its setpoint when recorded.
+    pub fn of(osc: &super::Oscillation, ts: f64, sp: Option<&[f64]>, samples: usize) -> Self {
         Self {
-            oscillating: osc.oscillating,
             unresolved_cycle: unresolved_cycle(osc, ts),
             setpoint_steady: sp.is_some_and(|sp| sp.windows(2).all(|w| w[1] == w[0])),
             pv_not_recorded: None,
+            period: osc.oscillating.then_some(osc.period).flatten(),
+            minutes: samples as f64 * ts / 60.0,
+            ts,
         }
     }
 
@@ -188,195 +89,214 @@ pub(crate) fn unresolved_cycle(osc: &super::Oscillation, ts: f64) -> Option<(f64
         })
 }
 
-/// Decide from the families' votes and what the oscillation shows (`motion`).
-pub(super) fn decide(families: &[FamilyEvidence], motion: &Motion) -> Decision {
-    let evidence = evidence_lines(families);
-    let of =
-        |v: Vote| -> Vec<&FamilyEvidence> { families.iter().filter(|f| f.vote == v).collect() };
-    let (pro, con) = (of(Vote::Stiction), of(Vote::NoStiction));
-    if let Some((verdict, confidence)) = by_valve(families) {
-        return Decision {
-            verdict,
-            confidence: Some(confidence),
-            reason: None,
-            next_step: next_step(verdict, Some(confidence), families, motion),
-            evidence,
-        };
-    }
-    if let Some(confidence) = by_hidden_valve(families) {
-        return Decision {
-            verdict: Verdict::Stiction,
-            confidence: Some(confidence),
-            reason: None,
-            next_step: next_step(Verdict::Stiction, Some(confidence), families, motion),
-            evidence,
-        };
-    }
-    let loop_pro = pro.iter().any(|f| f.family == Family::Loop);
-    let loop_holds = pro
-        .iter()
-        .any(|f| f.family == Family::Loop && f.strength >= 0.5);
-    let w = |f: &&FamilyEvidence| weight(f, loop_holds);
-    let total = |fs: &[&FamilyEvidence]| fs.iter().map(w).sum::<f64>();
-    let strongest = |fs: &[&FamilyEvidence]| fs.iter().map(w).fold(0.0, f64::max);
-    let leaning: Vec<&FamilyEvidence> = families
-        .iter()
-        .filter(|f| f.vote == Vote::Undetermined && f.leans.is_some())
-        .collect();
-    let (verdict, confidence, reason) = match (pro.is_empty(), con.is_empty()) {
-        (true, true) => {
-            let (verdict, reason) = without_votes(families, &leaning, motion);
-            (verdict, None, Some(reason))
-        }
-        (false, true) if strongest(&pro) < DECIDES => (
-            Verdict::Undetermined,
-            None,
-            Some(format!(
-                "only weak evidence points to stiction ({}), nothing against it",
-                names(&pro)
-            )),
-        ),
-        (false, true) => (Verdict::Stiction, Some(combined(pro.iter().map(w))), None),
-        (true, false) => (Verdict::NoStiction, Some(combined(con.iter().map(w))), None),
-        (false, false) => {
-            let (p, c) = (total(&pro), total(&con));
-            if p >= DOMINANCE * c && strongest(&con) <= WEAK_DISSENT && strongest(&pro) >= DECIDES {
-                (
-                    Verdict::Stiction,
-                    Some(combined(pro.iter().map(w)) * (1.0 - c / (p + c))),
-                    None,
-                )
-            } else if c >= DOMINANCE * p && strongest(&pro) <= WEAK_DISSENT && !loop_pro {
-                (
-                    Verdict::NoStiction,
-                    Some(combined(con.iter().map(w)) * (1.0 - p / (p + c))),
-                    None,
-                )
-            } else {
-                (
-                    Verdict::Undetermined,
-                    None,
-                    Some(format!(
-                        "the families disagree: {} point to stiction, {} do not",
-                        names(&pro),
-                        names(&con)
-                    )),
-                )
-            }
-        }
-    };
-    Decision {
-        verdict,
-        confidence,
-        reason,
-        next_step: next_step(verdict, confidence, families, motion),
-        evidence,
+/// The families whose statistics the model reads, and which.
+fn family_of(s: Statistic) -> Family {
+    match s {
+        Statistic::StickShare | Statistic::Sticks | Statistic::Stuck => Family::StickSlip,
+        Statistic::FitGain | Statistic::FitBand | Statistic::FitTest => Family::Model,
+        Statistic::CycleShape => Family::Shape,
+        Statistic::LoopLag => Family::Loop,
     }
 }
 
-/// The rules' decision turned to `stiction` by the families' statistics read together.
-pub(super) fn decided_by_combination(
-    before: Decision,
-    combined: &super::combined::CombinedEvidence,
-    families: &[FamilyEvidence],
+/// Each family's vote and strength from its statistics' share of the log-odds (the valve family
+/// keeps its own: it decides; the hidden valve's is its own, read by no one).
+fn set_votes(families: &mut [FamilyEvidence], reading: &Reading) {
+    for f in families.iter_mut() {
+        if matches!(f.family, Family::Valve | Family::HiddenValve) {
+            continue;
+        }
+        let parts: Vec<&Contribution> = reading
+            .contributions
+            .iter()
+            .filter(|c| family_of(c.statistic) == f.family && c.value.is_some())
+            .collect();
+        if parts.is_empty() {
+            (f.vote, f.strength, f.contribution) = (Vote::Undetermined, 0.0, None);
+            continue;
+        }
+        let c: f64 = parts.iter().map(|c| c.contribution).sum();
+        f.vote = if c >= VOTE {
+            Vote::Stiction
+        } else {
+            Vote::NoStiction
+        };
+        f.strength = 1.0 - (-c.abs()).exp();
+        f.contribution = Some(c);
+    }
+}
+
+/// Decide from the families' statistics (`measured`) and what the oscillation shows.
+pub(super) fn decide(
+    families: &mut [FamilyEvidence],
+    measured: &Measured,
     motion: &Motion,
 ) -> Decision {
-    let confidence = Some(combined.probability);
-    Decision {
-        verdict: Verdict::Stiction,
-        confidence,
-        reason: Some(combined.reason(before.verdict)),
-        next_step: next_step(Verdict::Stiction, confidence, families, motion),
-        evidence: before.evidence,
-    }
-}
-
-/// The verdict and reason when no family votes: leaning evidence, a withdrawn fit, an
-/// oscillation nobody explains, or a record nobody could judge.
-fn without_votes(
-    families: &[FamilyEvidence],
-    leaning: &[&FamilyEvidence],
-    motion: &Motion,
-) -> (Verdict, String) {
-    if !leaning.is_empty() {
-        return (Verdict::Undetermined, leaning_reason(leaning));
-    }
-    if model_flag(families, |m| m.op_moved_elsewhere) {
-        return (
-            Verdict::Undetermined,
-            "the loop moves, but only the closed-loop fit could judge it, and OP steps while the control error stays at rest (an input the record does not hold: a feed-forward, an override, an operator): PV need not follow those steps, so the fit's band is no vote, and no other family votes"
-                .to_string(),
-        );
-    }
-    if model_flag(families, |m| {
-        m.cycle_shape.as_ref().is_some_and(|c| c.foreign())
-    }) {
-        return (
-            Verdict::Undetermined,
-            "the loop moves, but only the closed-loop fit could judge it, and the valve it fits would give PV's regular cycle a shape PV does not have (steps' harmonics in a sinusoidal cycle): a cycle OP does not drive, as a sine added to PV, gives that; no other family votes"
-                .to_string(),
-        );
-    }
-    if model_flag(families, |m| m.fit_mirrors_controller) {
-        return (
-            Verdict::Undetermined,
-            "the loop moves, but only the closed-loop fit could judge it, and it explains PV through the controller's own law (a load OP does not explain moves the loop, not the setpoint): its gain with a band is no vote, and no other family votes"
-                .to_string(),
-        );
-    }
-    if motion.oscillating {
-        return (
-            Verdict::Undetermined,
-            "the loop oscillates but no family of evidence names the cause: the cycle is regular and near-sinusoidal, the fits with and without stiction alike, and the linear loop could sustain it by itself"
-                .to_string(),
-        );
-    }
-    let reason = match motion.unresolved_cycle {
-        Some((period, samples)) => format!(
-            "no family of evidence could judge this record: the control error cycles regularly every {period:.0} s, only {samples:.1} samples a cycle, \
-             which passes for measurement noise here; a sticky valve's cycle and a loop at its stability limit look alike at this sampling"
-        ),
-        None => "no family of evidence could judge this record: the loop is not excited enough (OP and PV hardly move above their noise, no oscillation)"
-            .to_string(),
-    };
-    (Verdict::InsufficientData, reason)
-}
-
-/// Whether the closed-loop fit's evidence carries `flag` (why its stiction vote was withdrawn).
-fn model_flag(
-    families: &[FamilyEvidence],
-    flag: impl Fn(&super::evidence::ModelEvidence) -> bool,
-) -> bool {
-    families
+    let model = VerdictModel::embedded();
+    let reading = model.read(|s| measured.get(s));
+    set_votes(families, &reading);
+    let p = reading.probability;
+    let valve = families
         .iter()
-        .any(|f| f.family == Family::Model && f.model.as_ref().is_some_and(&flag))
+        .find(|f| f.family == Family::Valve && f.vote != Vote::Undetermined);
+    if let Some(v) = valve {
+        let sticky = v.vote == Vote::Stiction;
+        let band = v
+            .valve
+            .as_ref()
+            .map(|e| e.d_percent_of_span)
+            .filter(|_| sticky);
+        return Decision {
+            verdict: if sticky {
+                Verdict::Stiction
+            } else {
+                Verdict::NoStiction
+            },
+            probability: Some(p),
+            reasons: vec![Reason::plain(Finding::ValvePosition {
+                band_percent_of_span: band,
+                sticky,
+            })],
+            next_step: NextStep::plain(if sticky {
+                Action::MaintainValve
+            } else {
+                Action::NoAction
+            }),
+            reading: Some(reading),
+        };
+    }
+    if !measured.any() {
+        let (finding, action) = match motion.unresolved_cycle {
+            Some((period, samples)) => (
+                Finding::UnresolvedCycle { period, samples },
+                Action::SampleFaster,
+            ),
+            None => (Finding::NotExcited, Action::LongerRecord),
+        };
+        let mut next = NextStep::plain(action);
+        next.sample_every = motion.unresolved_cycle.map(|(period, _)| period / 10.0);
+        return Decision {
+            verdict: Verdict::InsufficientData,
+            probability: None,
+            reading: None,
+            reasons: vec![Reason::plain(finding)],
+            next_step: next,
+        };
+    }
+    let verdict = if p >= model.stiction_from {
+        Verdict::Stiction
+    } else if p < model.no_stiction_below {
+        Verdict::NoStiction
+    } else {
+        Verdict::Undetermined
+    };
+    let reasons = reasons(verdict, &reading, families, measured, motion, model);
+    let next_step = next_step(verdict, p, &reading, motion, model);
+    Decision {
+        verdict,
+        probability: Some(p),
+        reading: Some(reading),
+        reasons,
+        next_step,
+    }
 }
 
-/// Why a record whose families measured something but none voted is undetermined: which lean
-/// which way, between their thresholds (their notes say by how much).
-fn leaning_reason(leaning: &[&FamilyEvidence]) -> String {
-    let side = |v: Vote| -> Vec<&FamilyEvidence> {
-        leaning
+/// The findings a group of statistics is told by: the sticks (their share and count), the hold,
+/// the fit (its gain, band or test), the cycle's shape, the loop's lag.
+fn group(s: Statistic) -> u8 {
+    match s {
+        Statistic::StickShare | Statistic::Sticks => 0,
+        Statistic::Stuck => 1,
+        Statistic::FitGain | Statistic::FitBand | Statistic::FitTest => 2,
+        Statistic::CycleShape => 3,
+        Statistic::LoopLag => 4,
+    }
+}
+
+/// The verdict's reasons: the findings that moved the log-odds most its way.
+fn reasons(
+    verdict: Verdict,
+    reading: &Reading,
+    families: &[FamilyEvidence],
+    measured: &Measured,
+    motion: &Motion,
+    model: &VerdictModel,
+) -> Vec<Reason> {
+    // each group's total and its strongest statistic
+    let mut groups: Vec<(f64, Statistic)> = Vec::new();
+    for g in 0..5u8 {
+        let parts: Vec<&Contribution> = reading
+            .contributions
             .iter()
-            .copied()
-            .filter(|f| f.leans == Some(v))
-            .collect()
-    };
-    let mut parts = Vec::new();
-    for (v, words) in [
-        (Vote::Stiction, "towards stiction"),
-        (Vote::NoStiction, "against stiction"),
-    ] {
-        let fams = side(v);
-        if !fams.is_empty() {
-            parts.push(format!("{words} ({})", names(&fams)));
+            .filter(|c| group(c.statistic) == g && c.value.is_some())
+            .collect();
+        if let Some(top) = parts
+            .iter()
+            .max_by(|a, b| a.contribution.abs().total_cmp(&b.contribution.abs()))
+        {
+            groups.push((parts.iter().map(|c| c.contribution).sum(), top.statistic));
         }
     }
-    format!(
-        "the evidence leans {} but lies between the thresholds, and no family votes: too weak to decide",
-        parts.join(" and ")
-    )
+    let toward = verdict == Verdict::Stiction || verdict == Verdict::Undetermined;
+    groups.retain(|(c, _)| if toward { *c >= VOTE } else { *c <= -VOTE });
+    groups.sort_by(|a, b| b.0.abs().total_cmp(&a.0.abs()));
+    let mut out: Vec<Reason> = groups
+        .iter()
+        .take(NAMED)
+        .filter_map(|&(c, s)| {
+            statistics::finding(s, families, measured, motion).map(|finding| Reason {
+                finding,
+                contribution: Some(c),
+                text: String::new(),
+            })
+        })
+        .collect();
+    match verdict {
+        Verdict::Undetermined => out.insert(
+            0,
+            Reason::plain(Finding::Between {
+                probability: reading.probability,
+                below: model.no_stiction_below,
+                from: model.stiction_from,
+            }),
+        ),
+        Verdict::NoStiction if out.is_empty() => {
+            out.push(Reason::plain(Finding::NothingOfAStickyValve))
+        }
+        _ => {}
+    }
+    out
 }
 
-#[cfg(test)]
-mod tests;
+/// What to do next.
+fn next_step(
+    verdict: Verdict,
+    p: f64,
+    reading: &Reading,
+    motion: &Motion,
+    model: &VerdictModel,
+) -> NextStep {
+    let sinusoidal = reading
+        .contributions
+        .iter()
+        .any(|c| c.statistic == Statistic::CycleShape && c.contribution <= -VOTE);
+    let action = match verdict {
+        Verdict::Stiction => Action::TravelTest,
+        Verdict::NoStiction if sinusoidal => Action::CheckTuning,
+        // nearer the undetermined band than to a clear healthy valve
+        Verdict::NoStiction if p >= model.no_stiction_below / 2.0 => Action::NoActionWeak,
+        Verdict::NoStiction => Action::NoAction,
+        Verdict::Undetermined => Action::SettleIt,
+        Verdict::InsufficientData => Action::LongerRecord,
+    };
+    let weak = matches!(action, Action::NoActionWeak | Action::SettleIt);
+    NextStep {
+        action,
+        setpoint_steady: weak && motion.setpoint_steady,
+        pv_not_recorded: motion
+            .pv_not_recorded
+            .filter(|_| verdict != Verdict::Stiction),
+        sample_every: None,
+        text: String::new(),
+    }
+}

@@ -31,7 +31,6 @@
 //! never on the ISDB.
 
 mod measure;
-pub(crate) use measure::{measurable_harmonics, share_of_cycles};
 mod vote;
 
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};

@@ -1,51 +1,6 @@
 //! The loop family's vote on fixed evidence.
 use super::*;
-use crate::diagnose::result::{Verdict, Vote};
-use crate::diagnose::verdict::{decide, Motion};
-
-fn vote(family: Family, vote: Vote, strength: f64) -> FamilyEvidence {
-    let mut f = FamilyEvidence::abstains(family, "", String::new(), String::new());
-    f.vote = vote;
-    f.strength = strength;
-    f
-}
-
-fn oscillating() -> Motion {
-    Motion {
-        oscillating: true,
-        unresolved_cycle: None,
-        setpoint_steady: false,
-        pv_not_recorded: None,
-    }
-}
-
-#[test]
-fn shape_and_fit_votes_against_do_not_outweigh_the_loop() {
-    // the issue: shape, fit and stick-slip read a near-sinusoid as linear
-    let against = [
-        vote(Family::Shape, Vote::NoStiction, 0.5),
-        vote(Family::Model, Vote::NoStiction, 0.6),
-        vote(Family::StickSlip, Vote::NoStiction, 0.5),
-    ];
-    let mut all = against.to_vec();
-    all.push(vote(Family::Loop, Vote::Stiction, 0.9));
-    assert_eq!(decide(&all, &oscillating()).verdict, Verdict::Stiction);
-    // weak loop evidence (no setpoint): never a confident no, the conflict is named
-    let mut weak = against[..1].to_vec();
-    weak.push(vote(Family::Loop, Vote::Stiction, 0.36));
-    let d = decide(&weak, &oscillating());
-    assert_eq!(d.verdict, Verdict::Undetermined);
-    let reason = d.reason.unwrap();
-    assert!(
-        reason.contains("linear loop") && reason.contains("shape"),
-        "{reason}"
-    );
-    // without the loop family the same votes against decide
-    assert_eq!(
-        decide(&against, &oscillating()).verdict,
-        Verdict::NoStiction
-    );
-}
+use crate::diagnose::result::Vote;
 
 /// A fast loop's cycle (fast-c-0004 of the plant benchmark: Stenman band 4.65 %, sampled every
 /// 5 s, a cycle of 8.8 samples), its harmonics left out.
@@ -197,34 +152,4 @@ fn a_long_record_lets_a_steady_amplitude_scatter_more() {
     // the Rayleigh-like scatter of a noise-driven resonance is never steady
     let swelling = marginal_over(200, 0.5, 0.1, 5.0, true);
     assert_eq!(swelling.vote, Vote::Undetermined, "{}", swelling.note);
-}
-
-/// A sinusoidal cycle in a loop at its stability limit (ISDB's CHEM11 is one, with a sticky
-/// valve): the shape family's `no_stiction` is kept, but the next step asks to detune first and
-/// to test the valve if the cycle stays, not to rule the valve out.
-#[test]
-fn a_sinusoidal_cycle_at_the_stability_limit_asks_to_detune_first() {
-    let mut e: LoopEvidence = serde_json::from_str(SHORT_CYCLE).unwrap();
-    e.needed_lag_degrees = 5.0;
-    e.needed_gain = 1.04;
-    e.harmonics = Some(0.005);
-    e.harmonic_count = 3;
-    let looped = super::vote::vote(e, "", String::new());
-    assert_eq!(looped.vote, Vote::Undetermined);
-    let shape = vote(Family::Shape, Vote::NoStiction, 0.33);
-    let d = decide(&[shape.clone(), looped], &oscillating());
-    assert_eq!(d.verdict, Verdict::NoStiction);
-    assert!(
-        d.next_step.contains("check the tuning first"),
-        "{}",
-        d.next_step
-    );
-    assert!(d.next_step.contains("test the valve"), "{}", d.next_step);
-    // without the loop at its limit, the cycle's shape rules the valve out as before
-    let d = decide(&[shape], &oscillating());
-    assert!(
-        d.next_step.starts_with("the valve is not the cause"),
-        "{}",
-        d.next_step
-    );
 }

@@ -20,6 +20,7 @@ pub(super) fn vote(mut e: LoopEvidence, statistic: &str, threshold: String) -> F
         family: Family::Loop,
         vote,
         strength,
+        contribution: None,
         value: Some(e.needed_lag_degrees),
         statistic: statistic.into(),
         threshold,

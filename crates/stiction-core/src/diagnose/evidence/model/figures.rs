@@ -1,12 +1,6 @@
 //! The fits' figures as the result reports them, and the words of the family's note on them.
 
-use super::{
-    loop_gain, unprovoked, CycleCancelled, CycleShape, Levels, LevelsEvidence, Unprovoked,
-    CALIBRATION, CYCLE_CANCELLED_STICTION, FIT_HARMONICS, FORCED_REGULARITY, FOREIGN_SHAPE,
-    LEVELS_STICTION, LIMIT_CYCLE_REGULARITY, MIN_EXPLAINED, MIN_LOOP_GAIN, SIGNIFICANCE_NONE,
-    SIGNIFICANCE_STICTION,
-};
-use crate::diagnose::evidence::valve::MIN_BAND_PERCENT;
+use super::Levels;
 use crate::diagnose::evidence::Context;
 use crate::identify::Structure;
 use crate::quantify::{FitComparison, OverLag};
@@ -47,14 +41,6 @@ pub struct ModelEvidence {
     pub correlation_span: f64,
     /// Share of the PV's variance above its noise explained with stiction.
     pub explained: f64,
-    /// The loop gain the fit implies: the fitted process gain times the gain of the PI
-    /// identified from the control error to OP (self-regulating structures only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub loop_gain: Option<f64>,
-    /// OP's steps the control error did not provoke ([`unprovoked`]); `None` when OP's increments
-    /// or PV's noise cannot be measured.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub unprovoked_op_steps: Option<Unprovoked>,
     /// Share of the output's variance that is noise.
     pub noise_share: f64,
     /// Gain of the linear part fitted with the best stiction model (PV units per OP unit; per
@@ -80,37 +66,13 @@ pub struct ModelEvidence {
     pub sse_stiction: f64,
     /// The measurement noise's expected sum of squares over the samples compared.
     pub sse_noise: f64,
-    /// How the test ratio was calibrated (`CALIBRATION`).
-    pub calibration: String,
-    /// The levels test, when the request is `thorough` and it ran.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub levels: Option<LevelsEvidence>,
-    /// The fits compared over whole periods of the cycle, where the loop oscillates and the
-    /// first comparison falls short of a stiction vote (`second_look`), or to check a stiction
-    /// vote on a cycle that keeps time like an input of fixed period ([`CycleCancelled`]).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub cycle_cancelled: Option<CycleCancelled>,
-    /// The stiction vote was withdrawn: the band's gain lay in a cycle that keeps time like an
-    /// input of fixed period, and over whole periods it gained nothing (`super::FORCED_REGULARITY`).
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub gain_in_a_clock_regular_cycle: bool,
-    /// The stiction vote was withdrawn: the fitted process and the identified PI make a loop
-    /// gain under `super::MIN_LOOP_GAIN`, so the fit explains PV through the controller's own law.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub fit_mirrors_controller: bool,
-    /// The stiction vote was withdrawn: OP steps that the control error did not provoke carry
-    /// `MAX_UNPROVOKED_SHARE` or more of OP's travel (a feed-forward, an override, an operator).
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub op_moved_elsewhere: bool,
-    /// On a regular cycle where the fit voted stiction, the harmonics of the cycle in the PV the
-    /// fitted valve gives and in the recorded PV ([`CycleShape`]); the vote was withdrawn where the
-    /// fit's shape is foreign to the record.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub cycle_shape: Option<CycleShape>,
-    /// The lag's bound (samples), when the lag reached it and the comparison over a third of it
-    /// (`super::BOUND_LAG_DIVISOR`), which `lag` then gives, had the higher test ratio.
+    /// The lag's bound (samples), when the lag reached it and the comparison over a third of it,
+    /// which `lag` then gives, had the higher test ratio.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lag_bound: Option<usize>,
+    /// The test could judge the record: enough independent changes, and PV varying above its
+    /// noise (otherwise the verdict's model does not read the fit).
+    pub judged: bool,
 }
 
 impl ModelEvidence {
@@ -191,8 +153,6 @@ pub(super) fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) 
         significance,
         correlation_span: f.correlation_span,
         explained,
-        loop_gain: loop_gain(ctx, f),
-        unprovoked_op_steps: unprovoked(ctx.op, &ctx.error, ctx.pv_noise),
         noise_share,
         gain: f.gain,
         time_constant: f.time_constant,
@@ -204,40 +164,7 @@ pub(super) fn model_evidence(ctx: &Context, f: &FitComparison, levels: &Levels) 
         sse_linear: f.linear.sse,
         sse_stiction: f.stenman.sse.min(f.slip_jump.sse),
         sse_noise: f.samples_used as f64 * f.noise_var,
-        calibration: CALIBRATION.into(),
-        levels: None,
-        cycle_cancelled: None,
-        gain_in_a_clock_regular_cycle: false,
-        fit_mirrors_controller: false,
-        op_moved_elsewhere: false,
         lag_bound: ctx.lag_bound,
-        cycle_shape: None,
-    }
-}
-
-/// The family's threshold, in words (with the levels test's where the request is `thorough`).
-pub(super) fn threshold_words(thorough: bool) -> String {
-    let threshold = format!(
-        "stiction when the improvement, held against the stiction fit's residual per independent change, reaches {SIGNIFICANCE_STICTION} \
-         (about the 95th percentile of simulated healthy loops; an independent change spans the residual's overlap with the band's effect); on a loop that limit-cycles (regularity {LIMIT_CYCLE_REGULARITY} or more) and stays under it, or on another oscillating loop where it finds none, the same test on \
-         changes over whole periods of the cycle, which cancel it, votes stiction at {CYCLE_CANCELLED_STICTION}; none at {SIGNIFICANCE_NONE} and below unless the loop limit-cycles \
-         or cycles regularly in under 4 samples (no fit resolves a stick there), or when OP explains under {:.0} % \
-         of the PV's variation above its noise; no stiction vote on a loop that does not limit-cycle when the fitted process and the identified PI \
-         make a loop gain under {MIN_LOOP_GAIN} (the fit then mirrors the controller); PV's changes are compared over 1.5 response times, \
-         at most a tenth of the record, and where the lag reaches that bound also over a third of it (the higher ratio kept); \
-         no stiction vote on a regular cycle (regularity {LIMIT_CYCLE_REGULARITY} or more) where the fitted valve gives PV harmonics of at least \
-         {FIT_HARMONICS} of the cycle's power and {FOREIGN_SHAPE} times those of the recorded PV (a shape PV does not have)",
-        100.0 * MIN_EXPLAINED
-    );
-    if thorough {
-        format!(
-            "{threshold}; or the levels test's ratio (the best Stenman valve against OP on PV's levels) reaches {LEVELS_STICTION} \
-             (about the 98th percentile of simulated healthy loops) with a band of at least {MIN_BAND_PERCENT} % of span, unless OP \
-             explains under {:.0} % or the cycle keeps time like an input of fixed period (regularity {FORCED_REGULARITY} or more) \
-             and over whole periods no band gains",
-            100.0 * MIN_EXPLAINED
-        )
-    } else {
-        threshold
+        judged: true,
     }
 }

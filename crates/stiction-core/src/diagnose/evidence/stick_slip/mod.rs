@@ -1,149 +1,119 @@
-//! The stick-slip family: a sticky valve that does not limit-cycle still shows itself as episodes
-//! in which OP travels (the integral action winding up) while PV stays inside its noise band, ended
-//! by a PV move in OP's direction when the valve breaks free (Kano et al. 2004's "stick, then
-//! jump"; Damarla et al. 2022/2023 test windows for "PV steady while OP changes"). The OP travel per
-//! stick is a model-free estimate of the band.
+//! The stick-slip family: a sticky valve that does not limit-cycle still shows itself in routine
+//! data. While it holds, the controller's integral action winds OP against the offset the held
+//! valve leaves and PV sits at one level inside its noise; then the valve breaks free and PV
+//! steps the way OP pushed it (Kano et al. 2004's "stick, then jump"; Damarla et al. 2022's
+//! windows of "PV steady while OP changes"). The family cuts PV into levels and reads which of
+//! PV's steps end such a stick ([`steps`]), and the longest OP travel against an offset PV holds
+//! without moving at all ([`stuck`]). The OP travel per stick is a model-free estimate of the
+//! band.
 //!
-//! Windows in which PV is steady while OP changes are common in healthy loops too, so an episode
-//! counts only when it cannot be one of the look-alikes:
-//! - PV not recorded (historian compression, a frozen transmitter): runs of repeated values or
-//!   exactly straight lines are not "PV steady";
-//! - quantised PV: the band is at least one quantum;
-//! - a slow process or a long delay: the identified linear loop, driven by the same OP through a
-//!   valve that follows it, must predict that PV would have left the band within the episode;
-//! - the ending PV move must go the way OP pushed (through the process gain's sign).
+//! A healthy valve's PV steps too, after a setpoint change or a load, and a slow process holds PV
+//! for its dead time after OP moves; those steps come right after a setpoint change, or after OP
+//! moved at once, or out of a PV still moving, or against OP's push, and none of them ends a
+//! stick. PV samples that look not recorded (historian compression, a frozen transmitter) are no
+//! level: a stick made mostly of them is left out.
+
+pub mod steps;
+pub mod stuck;
 
 use super::{Context, EvidenceFamily, Family, FamilyEvidence};
-use crate::diagnose::gates::plural;
 use crate::diagnose::result::Vote;
 use serde::{Deserialize, Serialize};
+pub use steps::StepSettings;
+pub use stuck::StuckSettings;
 
 /// The stick-slip family.
 pub struct StickSlip;
 
-/// Half-width of the PV's noise band, in noise standard deviations.
-pub(crate) const PV_BAND_SIGMAS: f64 = 2.5;
-/// OP must travel more than this many of its noise standard deviations in an episode.
-pub(crate) const OP_TRAVEL_SIGMAS: f64 = 4.0;
-/// Strength of a stiction vote: below what a verdict needs on its own (see the verdict).
-const STICTION_STRENGTH: f64 = 0.4;
-/// From this many episodes holding at least [`DECISIVE_SHARE`] of the OP's travel the vote is
-/// held with `DECISIVE_STRENGTH`, enough to decide alone. On the catalogue's calibration set and
-/// nine more draws of it (3,600 not-sticky loops, 3,300 sticky ones, 300 backlash valves), no
-/// not-sticky loop with 20 episodes or more spends more than 66 % of the OP's travel in them (the
-/// highest: an equal-percentage valve, 66 %, a saturating OP, 64 %, an external oscillation,
-/// 62 %); 36 sticky loops and 1 backlash valve reach 20 episodes holding 70 % or more.
-const DECISIVE_EPISODES: usize = 20;
-/// See [`DECISIVE_EPISODES`].
-const DECISIVE_SHARE: f64 = 0.7;
-/// Strength of a stiction vote from [`DECISIVE_EPISODES`] episodes: above the verdict's need.
-const DECISIVE_STRENGTH: f64 = 0.6;
-/// Episodes at and above which the family votes stiction ...
-pub(crate) const MIN_EPISODES: usize = 5;
-/// ... when at least this share of the OP's travel was spent stuck.
-const MIN_STUCK_SHARE: f64 = 0.5;
-/// At most this many episodes, with at least this share of OP travel ...
-const MAX_EPISODES_NONE: usize = 1;
-/// ... over at least this many quiet stretches, vote against stiction ...
-const MIN_STRETCHES_NONE: usize = 10;
-/// ... in a record of at least this many samples (a short record shows few sticks either way).
-const MIN_SAMPLES_NONE: usize = 400;
+/// Steps added to the count the stick share is read over (see `StickSlipEvidence::stick_share`).
+const SHARE_PRIOR: usize = 2;
+/// A stick of which more than this share of PV looks not recorded is left out.
+const MOST_UNRECORDED: f64 = 0.5;
 
-/// What the episodes show.
+/// What PV's steps and holds show.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StickSlipEvidence {
-    /// Episodes that count: OP travelled, PV stayed, then PV moved OP's way.
-    pub episodes: usize,
-    /// Share of the OP's travel spent in them.
-    pub stuck_share: f64,
-    /// Median OP travel per episode: a model-free band estimate, OP units and % of span.
+    /// PV's steps between levels (at least the settings' step in noise standard deviations).
+    pub steps: usize,
+    /// The steps that end a stick: OP wound while PV held, then PV stepped OP's way.
+    pub sticks: usize,
+    /// The share of PV's steps that end a stick, `sticks / (steps + 2)`: two steps more in the
+    /// count, so one stick of one step (a third) says less than six of eight (0.6).
+    pub stick_share: f64,
+    /// Median OP travel per stick: a model-free estimate of the band, OP units.
     pub median_travel: Option<f64>,
     /// The same, % of valve span.
     pub median_travel_percent_of_span: Option<f64>,
-    /// The PV band's half-width (PV units) and the OP noise (OP units) the episodes are held to.
-    pub pv_band: f64,
-    /// The OP noise standard deviation, OP units.
+    /// OP's longest travel, OP units, while PV held off the setpoint without moving towards it.
+    pub stuck_travel: f64,
+    /// The same, % of valve span.
+    pub stuck_travel_percent_of_span: f64,
+    /// That hold's samples `[start, end)` of the analysed stretch.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stuck_range: Option<[usize; 2]>,
+    /// The controller's sign the pushes were read with: +1 reverse action (OP rises when PV is
+    /// below the setpoint), -1 direct.
+    pub controller_sign: f64,
+    /// PV's and OP's noise standard deviations the levels and travels are held to.
+    pub pv_noise: f64,
+    /// OP's noise standard deviation, OP units.
     pub op_noise: f64,
-    /// Quiet stretches of PV the record was cut into.
-    pub quiet_stretches: usize,
-    /// Look-alikes left out: PV not recorded; a healthy valve would not have moved PV yet; PV
-    /// moved against OP's push.
-    pub skipped_unrecorded: usize,
-    /// Episodes left out because a healthy valve would not have moved PV yet (a slow process or a
-    /// long delay).
-    pub skipped_slow: usize,
-    /// Episodes left out because PV moved against OP's push.
-    pub skipped_direction: usize,
-    /// The episodes, as sample ranges `[start, end)` of the analysed stretch.
+    /// The sticks, as sample ranges `[start, end)` of the analysed stretch (the stick and its
+    /// step).
     pub ranges: Vec<[usize; 2]>,
 }
 
-mod episodes;
-pub use episodes::{episodes, Settings};
-
-/// The family's vote on its episodes (over a record of `samples`), its strength and why.
-fn ballot(e: &StickSlipEvidence, samples: usize) -> (Vote, f64, String) {
-    if e.episodes >= MIN_EPISODES && e.stuck_share >= MIN_STUCK_SHARE {
-        let decisive = e.episodes >= DECISIVE_EPISODES && e.stuck_share >= DECISIVE_SHARE;
-        (
-            Vote::Stiction,
-            // corroborating evidence only, unless the episodes are many and hold most of the
-            // OP's travel: on the calibration set, a few episodes alone called too many healthy
-            // loops that hold PV against a load sticky
-            if decisive {
-                DECISIVE_STRENGTH
-            } else {
-                STICTION_STRENGTH
-            },
-            format!(
-                "{} episodes of OP travelling while PV stayed put, then PV jumped OP's way ({:.0} % of the OP's travel; median {:.2} % of span per stick){}",
-                e.episodes,
-                100.0 * e.stuck_share,
-                e.median_travel_percent_of_span.unwrap_or(0.0),
-                if decisive {
-                    ": so many, holding so much of the OP's travel, that healthy loops do not give it"
-                } else {
-                    ""
-                }
-            ),
-        )
-    } else if e.episodes <= MAX_EPISODES_NONE
-        && e.quiet_stretches >= MIN_STRETCHES_NONE
-        && samples >= MIN_SAMPLES_NONE
-    {
-        (
-            Vote::NoStiction,
-            0.25,
-            format!(
-                "{} in {} of quiet PV: PV follows OP",
-                plural(e.episodes, "stick-slip episode", "stick-slip episodes"),
-                plural(e.quiet_stretches, "stretch", "stretches")
-            ),
-        )
-    } else if e.episodes >= MIN_EPISODES {
-        (
-            Vote::Undetermined,
-            0.0,
-            format!(
-                "{} episodes in {}, but they hold only {:.0} % of the OP's travel: a vote needs {:.0} %",
-                e.episodes,
-                plural(e.quiet_stretches, "quiet stretch", "quiet stretches"),
-                100.0 * e.stuck_share,
-                100.0 * MIN_STUCK_SHARE
-            ),
-        )
-    } else {
-        (
-            Vote::Undetermined,
-            0.0,
-            format!(
-                "{} ({:.0} % of the OP's travel) in {}: too few to decide (a vote needs {MIN_EPISODES})",
-                plural(e.episodes, "episode", "episodes"),
-                100.0 * e.stuck_share,
-                plural(e.quiet_stretches, "quiet stretch", "quiet stretches")
-            ),
-        )
+/// The controller's sign from routine data: the integral gain of a PI in velocity form
+/// (`Δop = Kc Δe + Ki e`, a constant beside them where the setpoint is not recorded), or its
+/// proportional gain where the integral's is nil.
+pub(crate) fn controller_sign(op: &[f64], error: &[f64], setpoint_recorded: bool) -> f64 {
+    let n = op.len().min(error.len());
+    let k = if setpoint_recorded { 2 } else { 3 };
+    let mut a = [[0.0; 3]; 3];
+    let mut b = [0.0; 3];
+    for t in 1..n {
+        let x = [error[t] - error[t - 1], error[t], 1.0];
+        let y = op[t] - op[t - 1];
+        if !(y.is_finite() && x[0].is_finite() && x[1].is_finite()) {
+            continue;
+        }
+        for i in 0..k {
+            b[i] += x[i] * y;
+            for j in 0..k {
+                a[i][j] += x[i] * x[j];
+            }
+        }
     }
+    match solve(a, b, k) {
+        Some(c) if c[1] != 0.0 => c[1].signum(),
+        Some(c) if c[0] != 0.0 => c[0].signum(),
+        _ => 1.0,
+    }
+}
+
+/// The first `k` unknowns of `a x = b` (Gaussian elimination with partial pivoting).
+fn solve(mut a: [[f64; 3]; 3], mut b: [f64; 3], k: usize) -> Option<[f64; 3]> {
+    for c in 0..k {
+        let p = (c..k).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
+        if a[p][c].abs() < 1e-300 {
+            return None;
+        }
+        a.swap(c, p);
+        b.swap(c, p);
+        for r in c + 1..k {
+            let f = a[r][c] / a[c][c];
+            for j in c..k {
+                a[r][j] -= f * a[c][j];
+            }
+            b[r] -= f * b[c];
+        }
+    }
+    let mut x = [0.0; 3];
+    for r in (0..k).rev() {
+        let s: f64 = (r + 1..k).map(|j| a[r][j] * x[j]).sum();
+        x[r] = (b[r] - s) / a[r][r];
+    }
+    Some(x)
 }
 
 impl EvidenceFamily for StickSlip {
@@ -152,75 +122,62 @@ impl EvidenceFamily for StickSlip {
     }
 
     fn evaluate(&self, ctx: &Context) -> FamilyEvidence {
-        let statistic = "episodes of OP travelling while PV stays inside its noise band, ended by a PV move OP's way";
-        let threshold = format!(
-            "stiction from {MIN_EPISODES} episodes holding {:.0} % of the OP's travel (decisive from {DECISIVE_EPISODES} holding {:.0} %); none with at most {MAX_EPISODES_NONE} over {MIN_STRETCHES_NONE} or more quiet stretches \
-             (OP beyond {OP_TRAVEL_SIGMAS} noise standard deviations, PV within ±{PV_BAND_SIGMAS})",
-            100.0 * MIN_STUCK_SHARE,
-            100.0 * DECISIVE_SHARE
-        );
-        let ts = ctx.req.ts;
-        let found = |g: Option<f64>| g.filter(|g| g.is_finite() && *g != 0.0);
-        let (pv_linear, rate, gain, dead_samples, response_samples) = match &ctx.fits {
-            // a level (its fit's gain a rate per second): what a valve step moves it by over the
-            // lag the fits compare (1.5 response times, at least a 25th of the record), a window
-            // the slip's move must show within
-            Some(f) if f.structure.integrating => (
-                None,
-                found(f.gain).map(|k| k * ts),
-                found(f.gain).map(|k| k * f.lag as f64 * ts),
-                (f.dead_time / ts).round() as usize,
-                f.lag,
-            ),
-            Some(f) => (
-                (!f.pv_linear.is_empty()).then_some(f.pv_linear.as_slice()),
-                None,
-                found(f.gain),
-                (f.dead_time / ts).round() as usize,
-                ((f.dead_time + 2.0 * f.time_constant.unwrap_or(0.0)) / ts).round() as usize + 1,
-            ),
-            None => (None, None, None, 0, 3),
-        };
-        // Every loop is judged on PV itself, levels too: a stuck level valve leaves the level
-        // still where the flows nearly balance. Judging a level's smoothed rate instead (which a
-        // stuck valve holds) was measured on the plant benchmark's calibration set, with the
-        // rate's noise carried through the smoothing: no more sticky loops found, more healthy
-        // ones left undetermined (balanced accuracy 0.627 to 0.620).
-        let settings = Settings {
+        let settings = &ctx.req.settings;
+        let sign = controller_sign(ctx.op, &ctx.error, ctx.sp.is_some());
+        let signals = steps::Signals {
+            op: ctx.op,
+            pv: ctx.pv,
+            error: &ctx.error,
+            sp: ctx.sp,
+            sign,
             pv_noise: ctx.pv_noise,
             op_noise: ctx.op_noise,
-            pv_quantum: ctx.pv_quantum,
-            unrecorded: &ctx.unrecorded,
-            pv_linear,
-            rate,
-            gain,
-            dead_samples,
-            response_samples,
         };
-        let mut e = episodes(ctx.op, ctx.pv, &settings);
-        e.median_travel_percent_of_span = e.median_travel.map(|t| ctx.req.percent_of_span(t));
-        let (vote, strength, why) = ballot(&e, ctx.op.len());
-        // enough episodes that hold too little of the OP's travel: evidence, too weak to decide
-        let leans =
-            (vote == Vote::Undetermined && e.episodes >= MIN_EPISODES).then_some(Vote::Stiction);
-        let skipped = e.skipped_unrecorded + e.skipped_slow + e.skipped_direction;
-        let note = if skipped > 0 {
-            format!(
-                "{why}; left out as look-alikes: {} with PV not recorded, {} a healthy valve would also give (slow process), {} with PV moving against OP",
-                e.skipped_unrecorded, e.skipped_slow, e.skipped_direction
-            )
-        } else {
-            why
+        let found = steps::steps(&signals, &settings.steps);
+        let sticks: Vec<steps::Stick> = found
+            .sticks
+            .into_iter()
+            .filter(|s| ctx.unrecorded_share(s.start, s.end) <= MOST_UNRECORDED)
+            .collect();
+        // (a hold needs no recorded noise: PV held far off the setpoint is a finding even where
+        // the historian stored it flat, since a move towards the setpoint would have been stored)
+        let hold = stuck::longest_hold(
+            ctx.op,
+            ctx.pv,
+            &ctx.error,
+            sign,
+            ctx.pv_noise,
+            &settings.stuck,
+        );
+        let mut travels: Vec<f64> = sticks.iter().map(|s| s.travel.abs()).collect();
+        travels.sort_by(f64::total_cmp);
+        let median_travel = (!travels.is_empty()).then(|| travels[travels.len() / 2]);
+        let stuck_travel = hold.map_or(0.0, |h| h.0);
+        let e = StickSlipEvidence {
+            steps: found.steps,
+            sticks: sticks.len(),
+            stick_share: sticks.len() as f64 / (found.steps + SHARE_PRIOR) as f64,
+            median_travel,
+            median_travel_percent_of_span: median_travel.map(|t| ctx.req.percent_of_span(t)),
+            stuck_travel,
+            stuck_travel_percent_of_span: ctx.req.percent_of_span(stuck_travel),
+            stuck_range: hold.map(|h| h.1),
+            controller_sign: sign,
+            pv_noise: ctx.pv_noise,
+            op_noise: ctx.op_noise,
+            ranges: sticks.iter().map(|s| [s.start, s.end]).collect(),
         };
+        let note = note(&e, ctx.req.ts);
         FamilyEvidence {
             family: Family::StickSlip,
-            vote,
-            strength,
-            value: Some(e.episodes as f64),
-            statistic: statistic.into(),
-            threshold,
+            vote: Vote::Undetermined,
+            strength: 0.0,
+            contribution: None,
+            value: Some(e.stick_share),
+            statistic: "the share of PV's steps that end a stick (OP wound while PV held, then PV stepped OP's way)".into(),
+            threshold: "read by the verdict's model with the sticks' count and OP's longest travel against a held offset".into(),
             note,
-            leans,
+            leans: None,
             model: None,
             stick_slip: Some(e),
             valve: None,
@@ -230,5 +187,47 @@ impl EvidenceFamily for StickSlip {
     }
 }
 
+/// What the family measured, in one line.
+fn note(e: &StickSlipEvidence, ts: f64) -> String {
+    let mut s = if e.steps == 0 {
+        "PV makes no step out of its noise between levels".to_string()
+    } else {
+        format!(
+            "{} of PV's {} {} ended a stick{}",
+            e.sticks,
+            e.steps,
+            if e.steps == 1 { "step" } else { "steps" },
+            e.median_travel_percent_of_span
+                .map_or(String::new(), |t| format!(
+                    " (OP wound a median {t:.2} % of span while PV held, then PV stepped OP's way)"
+                ))
+        )
+    };
+    if let Some([a, b]) = e.stuck_range {
+        s.push_str(&format!(
+            "; OP travelled {:.2} % of span over {:.0} min while PV held off the setpoint",
+            e.stuck_travel_percent_of_span,
+            (b - a) as f64 * ts / 60.0
+        ));
+    }
+    s
+}
+
 #[cfg(test)]
-mod tests;
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_controller_sign_is_read_off_the_integral_action() {
+        // a reverse-acting PI: OP rises while the error is positive
+        let error: Vec<f64> = (0..300).map(|i| ((i as f64) / 20.0).sin()).collect();
+        let mut op = vec![50.0];
+        for t in 1..error.len() {
+            let last = op[t - 1];
+            op.push(last + 0.5 * (error[t] - error[t - 1]) + 0.05 * error[t]);
+        }
+        assert_eq!(controller_sign(&op, &error, true), 1.0);
+        let direct: Vec<f64> = op.iter().map(|v| 100.0 - v).collect();
+        assert_eq!(controller_sign(&direct, &error, false), -1.0);
+    }
+}

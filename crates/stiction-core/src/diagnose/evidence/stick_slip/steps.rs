@@ -26,8 +26,10 @@ pub struct StepSettings {
     pub penalty: f64,
     /// Fewest samples of a level a step is read between.
     pub min_level: usize,
-    /// Most samples of short levels between two levels for the change to count as one step.
+    /// Most samples between two levels for the change to count as one step ...
     pub max_transition: usize,
+    /// ... or this share of the level before, if longer: a slip is fast beside its stick.
+    pub transition_share: f64,
     /// A step is at least this many PV noise standard deviations.
     pub min_step: f64,
     /// OP travels at least this many of its noise standard deviations over a stick.
@@ -52,6 +54,7 @@ impl Default for StepSettings {
             penalty: 3.0,
             min_level: 4,
             max_transition: 6,
+            transition_share: 0.25,
             min_step: 3.0,
             op_travel: 5.0,
             lead: 3,
@@ -66,7 +69,9 @@ impl Default for StepSettings {
 /// One level of PV: samples `[start, end)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Level {
+    /// First sample.
     pub start: usize,
+    /// One past the last sample.
     pub end: usize,
 }
 
@@ -175,7 +180,9 @@ fn trend(x: &[f64]) -> f64 {
 
 /// The signals the steps are read from.
 pub struct Signals<'a> {
+    /// Controller output.
     pub op: &'a [f64],
+    /// Process variable.
     pub pv: &'a [f64],
     /// The control error, SP - PV (or PV's deviation from its mean without SP).
     pub error: &'a [f64],
@@ -183,7 +190,9 @@ pub struct Signals<'a> {
     pub sp: Option<&'a [f64]>,
     /// The controller's sign: +1 where OP rises with the error (reverse action), -1 direct.
     pub sign: f64,
+    /// PV's noise standard deviation.
     pub pv_noise: f64,
+    /// OP's noise standard deviation.
     pub op_noise: f64,
 }
 
@@ -194,27 +203,38 @@ pub fn steps(s: &Signals, set: &StepSettings) -> Steps {
         return Steps::default();
     }
     let beta = set.penalty * s.pv_noise * s.pv_noise * (n as f64).ln();
-    let long: Vec<Level> = levels(s.pv, beta, set.max_level)
-        .into_iter()
-        .filter(|l| l.end - l.start >= set.min_level)
-        .collect();
+    let all = levels(s.pv, beta, set.max_level);
+    let means: Vec<f64> = all.iter().map(|l| mean(&s.pv[l.start..l.end])).collect();
+    let long = |l: &Level| l.end - l.start >= set.min_level;
     let changed = |a: usize, b: usize| {
         s.sp.is_some_and(|sp| (a.max(1)..b.min(n)).any(|i| sp[i] != sp[i - 1]))
     };
     let mut out = Steps::default();
-    for w in long.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        if b.start - a.end > set.max_transition {
+    let mut i = 0;
+    while i < all.len() {
+        let a = all[i];
+        // the level PV lands on: the first long one a step away, reached quickly (within the
+        // transition the settings allow, or a share of the level before: a slip is fast beside
+        // the stick that leads to it; a slow process's rise is not)
+        let limit = set
+            .max_transition
+            .max((set.transition_share * (a.end - a.start) as f64) as usize);
+        let landing = long(&a).then(|| {
+            (i + 1..all.len())
+                .take_while(|&j| all[j].start - a.end <= limit)
+                .find(|&j| {
+                    long(&all[j]) && (means[j] - means[i]).abs() >= set.min_step * s.pv_noise
+                })
+        });
+        let Some(j) = landing.flatten() else {
+            i += 1;
             continue;
-        }
-        let step = mean(&s.pv[b.start..b.end]) - mean(&s.pv[a.start..a.end]);
-        if step.abs() < set.min_step * s.pv_noise {
-            continue;
-        }
+        };
         out.steps += 1;
-        if let Some(stick) = stick(s, set, a, b.start, step, &changed) {
+        if let Some(stick) = stick(s, set, a, all[j].start, means[j] - means[i], &changed) {
             out.sticks.push(stick);
         }
+        i = j;
     }
     out
 }
