@@ -52,7 +52,7 @@ use summary::{Fate, Row, SourceStatus};
   stiction batch plant/ -o out --sp sp --resume      # after an interruption: done loops are kept
 
 Writes OUTDIR/summary.csv and summary.json (one row per loop, ranked by severity = apparent
-stiction x confidence for a stiction verdict, then verdict, then loop id), OUTDIR/loops/<id>.json
+stiction x the probability of a sticky valve for a stiction verdict, then verdict, then loop id), OUTDIR/loops/<id>.json
 (the full diagnosis and where it came from), and with --reports OUTDIR/reports/<id>.html and
 OUTDIR/index.html. A loop that cannot be read is a 'failed' row with the reason; the batch goes on.
 Loop ids: the file stem, the loop id cell of a long-format file, or the loop's name in a loop list

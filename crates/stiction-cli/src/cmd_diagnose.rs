@@ -1,4 +1,5 @@
-//! `stiction diagnose`: quality gates, oscillation, stiction indices and a verdict for one loop.
+//! `stiction diagnose`: quality gates, the families' statistics, the probability of a sticky
+//! valve and a verdict for one loop; `--settings` prints how it measures and decides.
 
 use crate::exit::FailOn;
 use crate::human::print_diagnosis;
@@ -6,7 +7,6 @@ use crate::loop_file::Columns;
 use crate::loop_messages::{core_error, print_notes};
 use anyhow::Result;
 use std::path::PathBuf;
-use stiction_core::diagnose::diagnose_checked;
 
 #[derive(clap::Args, Clone)]
 #[command(after_help = "Examples:
@@ -15,13 +15,15 @@ use stiction_core::diagnose::diagnose_checked;
   stiction diagnose level.xlsx --sheet Data --op OP --pv PV --integrating --window 2000
   stiction diagnose plant.csv.gz --time-format '%d.%m.%Y %H:%M:%S' --tz Europe/Berlin
   stiction diagnose loop.csv --fail-on stiction || echo 'valve needs maintenance'
+  stiction diagnose --settings
 
 Reads CSV (comma, semicolon or tab), .csv.gz, .xlsx/.xls/.ods, .parquet, or - for standard
 input, the format found from the file's bytes. Blank cells, NaN, #N/A and historian states such as
 Bad Input, I/O Timeout, Comm Fail or Shutdown are gaps.")]
 pub struct Args {
     /// Data file: CSV with a header line, .csv.gz, a workbook, Parquet, or - for standard input
-    pub file: PathBuf,
+    #[arg(required_unless_present = "settings")]
+    pub file: Option<PathBuf>,
     #[command(flatten)]
     pub columns: Columns,
     /// Add a verdict per window of this many samples (locates intermittent stiction)
@@ -33,20 +35,28 @@ pub struct Args {
     /// Print the diagnosis as JSON
     #[arg(long)]
     pub json: bool,
+    /// Print how diagnose measures (its settings, at their defaults) and decides (the verdict's
+    /// model: statistics, knots, weights, references, thresholds), then stop; no FILE needed
+    #[arg(long, conflicts_with_all = ["window", "no_quantify", "fail_on"])]
+    pub settings: bool,
     /// Exit with code 4 when the verdict is stiction (after printing it), for scripts
     #[arg(long, value_enum, value_name = "VERDICT")]
     pub fail_on: Option<FailOn>,
 }
 
 pub fn run(a: Args) -> Result<()> {
-    let table = a.columns.open(&a.file)?;
+    let Some(file) = a.file.as_ref().filter(|_| !a.settings) else {
+        return crate::human::settings::print(a.json);
+    };
+    let table = a.columns.open(file)?;
     let lf = a.columns.read(&table)?;
     let mut req = a.columns.request(lf.ts);
     req.window = a.window;
     req.quantify = !a.no_quantify;
     let name = table.path.display().to_string();
     let req = req.check().map_err(|e| core_error(&name, &lf, e))?;
-    let d = diagnose_checked(&lf.record(), &req).map_err(|e| core_error(&name, &lf, e))?;
+    let d =
+        crate::diagnosed::diagnose(&lf.record(), &req).map_err(|e| core_error(&name, &lf, e))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&d)?);
         print_notes(&name, &lf, true);

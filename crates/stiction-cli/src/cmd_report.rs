@@ -8,7 +8,6 @@ use crate::loop_file::Columns;
 use crate::words::verdict;
 use anyhow::{Context, Result};
 use std::path::PathBuf;
-use stiction_core::diagnose::diagnose_checked;
 use stiction_report::PageOptions;
 
 #[derive(clap::Args)]
@@ -44,7 +43,7 @@ pub fn run(a: Args) -> Result<()> {
     let id = table.path.display().to_string();
     let core_error = |e| crate::loop_messages::core_error(&id, &lf, e);
     let req = req.check().map_err(core_error)?;
-    let d = diagnose_checked(&lf.record(), &req).map_err(core_error)?;
+    let d = crate::diagnosed::diagnose(&lf.record(), &req).map_err(core_error)?;
     let names = a.columns.names();
     let reading = lf.reading_notes();
     let options = PageOptions {
@@ -58,8 +57,8 @@ pub fn run(a: Args) -> Result<()> {
     println!(
         "{id}: {}{}; report written to {}",
         verdict(d.verdict),
-        d.confidence
-            .map(|c| format!(" (confidence {c:.2})"))
+        d.probability
+            .map(|p| format!(" (P {p:.2})"))
             .unwrap_or_default(),
         a.output.display()
     );

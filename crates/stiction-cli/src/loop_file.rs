@@ -103,11 +103,9 @@ pub struct Columns {
     /// --estimate-start; about 3-4x the estimate's time)
     #[arg(long)]
     pub estimate_start: bool,
-    /// Model family: also score every distinct Stenman valve on PV's levels (the levels test;
-    /// finds more sticky valves in records sampled at every controller execution, 1 to 3 s
-    /// a loop of 2,000 samples); where no family has decided stiction on a limit cycle, also the
-    /// hidden-valve family (a particle filter over a valve that slips between the samples,
-    /// about 1 s more on two cores, 3 s where it votes stiction: the median of three draws)
+    /// Also the hidden-valve family: a particle filter over a sticky valve that slips between
+    /// the samples, on a loop that oscillates (about 1 s more on two cores, 3 s where it finds
+    /// one: the median of three draws); it reports beside the verdict, which does not read it
     #[arg(long)]
     pub thorough: bool,
     #[command(flatten)]

@@ -11,6 +11,7 @@ mod cmd_report;
 mod cmd_reproduce;
 mod cmd_simulate;
 mod data;
+mod diagnosed;
 mod exit;
 mod human;
 mod loop_file;
@@ -50,7 +51,7 @@ enum Command {
     Estimate(cmd_estimate::Args),
     /// Quantify stiction from OP and PV alone (closed-loop Hammerstein identification).
     Quantify(cmd_quantify::Args),
-    /// Diagnose a loop from routine data: quality gates, oscillation, stiction indices and a verdict.
+    /// Diagnose a loop from routine data: the probability of a sticky valve, a verdict, its reasons and the next step.
     Diagnose(cmd_diagnose::Args),
     /// Diagnose a loop and write one self-contained HTML report (inline SVG charts, no network).
     Report(cmd_report::Args),

@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
-use stiction_core::diagnose::{diagnose_checked, Diagnosis};
+use stiction_core::diagnose::Diagnosis;
 use stiction_core::fleet;
 use stiction_report::fleet::Spark;
 use stiction_report::PageOptions;
@@ -282,7 +282,7 @@ fn process(job: Job, ctx: &Ctx) -> Option<Row> {
     // the request is the loop's own (its sampling time): checked once, then run
     let d = match req
         .check()
-        .and_then(|req| diagnose_checked(&lf.record(), &req))
+        .and_then(|req| crate::diagnosed::diagnose(&lf.record(), &req))
     {
         Ok(d) => d,
         Err(e) => return Some(Row::failed(&id, &source, format!("{source}: {e}"))),

@@ -24,7 +24,7 @@ pub struct LoopSettings {
     pub ts: Option<f64>,
     pub integrating: bool,
     pub estimate_start: bool,
-    /// The levels test (`--thorough`).
+    /// The hidden-valve family (`--thorough`).
     #[serde(default)]
     pub thorough: bool,
     pub quantify: bool,

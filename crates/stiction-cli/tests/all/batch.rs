@@ -105,9 +105,10 @@ fn a_folder_is_ranked_with_the_bad_loop_failed_and_the_rest_diagnosed() {
     assert_eq!(rows[0]["verdict"], "stiction");
     let severity: f64 = rows[0]["severity"].parse().unwrap();
     let band: f64 = rows[0]["band_percent_of_span"].parse().unwrap();
-    let confidence: f64 = rows[0]["confidence"].parse().unwrap();
+    let probability: f64 = rows[0]["probability"].parse().unwrap();
     assert!(band > 1.0 && band < 3.0, "band {band}");
-    assert!((severity - band * confidence).abs() < 1e-12);
+    assert!((severity - band * probability).abs() < 1e-12);
+    assert!(!rows[0]["reason"].is_empty());
     assert_eq!(rows[0]["samples"], "1500");
     assert_eq!(rows[0]["error"], "");
     assert_eq!(rows[1]["loop_id"], "healthy");

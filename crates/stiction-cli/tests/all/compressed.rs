@@ -32,9 +32,13 @@ fn a_mostly_unrecorded_pv_says_compression_hides_sticks() {
     let f = squeezed.to_str().unwrap();
     let v = json(&ok(&["diagnose", f, "--sp", "sp", "--json"]));
     assert_ne!(v["verdict"], "stiction", "{v:#}");
-    let step = v["next_step"].as_str().unwrap();
+    let step = v["next_step"]["text"].as_str().unwrap();
     assert!(step.contains("PV is not recorded in"), "{step}");
     assert!(step.contains("without compression"), "{step}");
+    assert!(
+        v["next_step"]["pv_not_recorded"].as_f64().is_some(),
+        "{v:#}"
+    );
     // the record stored whole says nothing of compression
     let v = json(&ok(&[
         "diagnose",
@@ -43,6 +47,6 @@ fn a_mostly_unrecorded_pv_says_compression_hides_sticks() {
         "sp",
         "--json",
     ]));
-    let step = v["next_step"].as_str().unwrap();
+    let step = v["next_step"]["text"].as_str().unwrap();
     assert!(!step.contains("compression"), "{step}");
 }

@@ -30,7 +30,21 @@ fn a_sticky_loop_is_stiction_with_the_band_sized() {
     let f = simulate(dir.path(), "sticky.csv", "2", &[]);
     let v = json(&ok(&["diagnose", &f, "--sp", "sp", "--json"]));
     assert_eq!(v["verdict"], "stiction", "{v:#}");
-    assert!(v["confidence"].as_f64().unwrap() > 0.5);
+    let p = v["probability"].as_f64().unwrap();
+    assert!(p > 0.0 && p <= 1.0, "{p}");
+    // the one or two reasons that decided it, typed and in words
+    let reasons = v["reasons"].as_array().unwrap();
+    assert!(!reasons.is_empty() && reasons.len() <= 2, "{v:#}");
+    for r in reasons {
+        assert!(r["kind"].as_str().is_some(), "{r:#}");
+        assert!(!r["text"].as_str().unwrap().is_empty(), "{r:#}");
+    }
+    // the model's reading: every statistic, its value and its share of the log-odds
+    let read = v["statistics"]["contributions"].as_array().unwrap();
+    assert!(!read.is_empty());
+    for c in read {
+        assert!(c["statistic"].as_str().is_some() && c["contribution"].as_f64().is_some());
+    }
     let names: Vec<&str> = v["indices"]
         .as_array()
         .unwrap()
@@ -39,47 +53,73 @@ fn a_sticky_loop_is_stiction_with_the_band_sized() {
         .collect();
     assert!(names.contains(&"cross_correlation") && names.contains(&"curve_fitting"));
     assert!(names.contains(&"harmonics") && names.contains(&"shape"));
-    // every family reports its value, threshold and vote; the fit with stiction votes for it
+    // every family reports its value, threshold and vote
     let families = v["families"].as_array().unwrap();
     for name in ["valve", "model", "stick_slip", "shape", "loop"] {
         let f = families.iter().find(|f| f["family"] == name).unwrap();
         assert!(f["threshold"].as_str().is_some() && f["vote"].as_str().is_some());
     }
-    // a regular limit cycle is fitted about as well without stiction: the fits do not vote
-    // against the valve, the loop family (the cycle the linear loop cannot sustain) votes for it
     let model = families.iter().find(|f| f["family"] == "model").unwrap();
-    assert_ne!(model["vote"], "no_stiction", "{model:#}");
     assert!(
         model["model"]["r2_stenman"].as_f64().unwrap() > 0.9,
         "{model:#}"
     );
-    let lp = families.iter().find(|f| f["family"] == "loop").unwrap();
-    assert_eq!(lp["vote"], "stiction", "{lp:#}");
     for i in v["indices"].as_array().unwrap() {
         assert!(i["threshold"].as_str().is_some() && i["vote"].as_str().is_some());
     }
     let d = v["band"]["band_percent_of_span"].as_f64().unwrap();
     assert!(d > 0.5 && d < 4.0, "band {d}");
     assert_eq!(v["band"]["source"], "closed_loop");
-    assert!(v["next_step"].as_str().unwrap().contains("valve"), "{v:#}");
+    assert_eq!(v["next_step"]["action"], "travel_test", "{v:#}");
+    assert!(
+        v["next_step"]["text"].as_str().unwrap().contains("valve"),
+        "{v:#}"
+    );
     assert!(v["oscillation"]["period"].as_f64().unwrap() > 10.0);
-    // the human printer says the same
+    // the human printer says the same: the verdict and P first, the reasons, the band, the
+    // next step, then every family's detail
     let text = ok(&["diagnose", &f, "--sp", "sp", "--no-quantify"]);
-    assert!(text.contains("STICTION"), "{text}");
+    let first = text.lines().next().unwrap();
+    assert!(first.ends_with(&format!(": STICTION (P {p:.2})")), "{text}");
     assert!(text.contains("cross_correlation"), "{text}");
     assert!(text.contains("closed-loop fit's scan"), "{text}");
     let text = ok(&["diagnose", &f, "--sp", "sp"]);
+    let lines: Vec<&str> = text.lines().collect();
+    let at = |start: &str| {
+        lines
+            .iter()
+            .position(|l| l.trim_start().starts_with(start))
+            .unwrap_or_else(|| panic!("no line {start:?} in:\n{text}"))
+    };
+    let (why, band, next, details) = (
+        at("why:"),
+        at("stiction band:"),
+        at("next step:"),
+        at("details"),
+    );
+    assert!(why < band && band < next && next < details, "{text}");
+    for r in reasons {
+        assert!(text.contains(r["text"].as_str().unwrap()), "{text}");
+    }
     assert!(text.contains("closed-loop fit: R²"), "{text}");
     assert!(text.contains("% of valve span"), "{text}");
-    assert!(text.contains("next step:"), "{text}");
-    // the statistics read together agree with the rules, which decided
-    assert!(
-        text.lines()
-            .any(|l| l.trim_start().starts_with("statistics combined")
-                && l.contains("the rules had already decided")),
-        "{text}"
-    );
-    assert_eq!(v["combined"]["decided"], false, "{v:#}");
+    // one line per family under details, with its vote and share of the log-odds
+    for f in families {
+        let words = match f["family"].as_str().unwrap() {
+            "valve" => "valve position",
+            "model" => "closed-loop fit",
+            "stick_slip" => "stick-slip episodes",
+            "shape" => "shape of the oscillation",
+            "loop" => "linear loop",
+            other => panic!("{other}"),
+        };
+        assert!(
+            lines[details..]
+                .iter()
+                .any(|l| l.trim_start().starts_with(words)),
+            "{words}: {text}"
+        );
+    }
     assert_eq!(v["quantification"]["valve_start_kind"], "first_op");
     let v = json(&ok(&[
         "diagnose",
@@ -109,29 +149,34 @@ fn a_healthy_loop_with_noise_only_is_no_stiction() {
     let small = reach["small_band_percent_of_span"].as_f64().unwrap();
     let large = reach["large_band_percent_of_span"].as_f64().unwrap();
     assert!((small - 4.0 * sd).abs() < 1e-9 && (large - 12.0 * sd).abs() < 1e-9);
-    // the statistics read together cast no vote on a healthy valve, and say so
-    let combined = &v["combined"];
+    // why, in words, and a next step that leaves the valve alone
+    let reasons = v["reasons"].as_array().unwrap();
+    assert!(!reasons.is_empty(), "{v:#}");
+    assert!(reasons
+        .iter()
+        .all(|r| !r["text"].as_str().unwrap().is_empty()));
+    let action = v["next_step"]["action"].as_str().unwrap();
     assert!(
-        combined["probability"].as_f64().unwrap() < combined["threshold"].as_f64().unwrap(),
-        "{combined:#}"
+        ["no_action", "no_action_weak", "check_tuning"].contains(&action),
+        "{action}"
     );
-    assert_eq!(combined["decided"], false);
-    assert_eq!(combined["statistics"].as_array().unwrap().len(), 45);
     let human = ok(&["diagnose", &f, "--sp", "sp"]);
+    let p = v["probability"].as_f64().unwrap();
     assert!(
         human
             .lines()
-            .any(|l| l.trim_start().starts_with("statistics combined")
-                && l.contains("undetermined")
-                && l.contains("only ever add a stiction verdict")),
+            .next()
+            .unwrap()
+            .ends_with(&format!(": no stiction (P {p:.2})")),
         "{human}"
     );
+    assert!(human.contains("why:"), "{human}");
     let line = human
         .lines()
         .find(|l| l.trim_start().starts_with("what this record can show:"))
         .unwrap_or_else(|| panic!("no reach line in:\n{human}"));
     assert!(
-        line.contains(&format!("under {small:.2} % of span")),
+        line.contains("times OP's noise") && !line.contains("simulated"),
         "{line}"
     );
 }
@@ -154,7 +199,12 @@ fn windows_locate_the_verdict_in_time() {
     assert_eq!(w[2]["end"], 1500);
     for x in w {
         assert!(x["verdict"].as_str().is_some());
+        for r in x["reasons"].as_array().unwrap() {
+            assert!(!r["text"].as_str().unwrap().is_empty(), "{x:#}");
+        }
     }
+    let text = ok(&["diagnose", &f, "--window", "500", "--no-quantify"]);
+    assert!(text.contains("windows:"), "{text}");
 }
 
 /// The sticky loop exported the way a historian does: semicolons, decimal commas, text
@@ -214,7 +264,10 @@ fn historian_exports_with_timestamps_decimal_commas_and_a_mode_column() {
     args.push("--json");
     let v = json(&ok(&args));
     assert_eq!(v["verdict"], "insufficient_data");
-    assert!(v["reason"].as_str().unwrap().contains("manual"), "{v:#}");
+    assert!(
+        v["reasons"][0]["text"].as_str().unwrap().contains("manual"),
+        "{v:#}"
+    );
 
     // a gap in the time axis splits the record; the longer stretch is judged
     let g = historian(dir.path(), 0, Some(700));
@@ -288,7 +341,10 @@ fn a_still_op_is_insufficient_data_and_op_off_its_span_is_said() {
     let v = json(&ok(&["diagnose", p.to_str().unwrap(), "--json"]));
     assert_eq!(v["verdict"], "insufficient_data", "{v:#}");
     assert!(
-        v["reason"].as_str().unwrap().contains("OP stays at 50"),
+        v["reasons"][0]["text"]
+            .as_str()
+            .unwrap()
+            .contains("OP stays at 50"),
         "{v:#}"
     );
     // OP in raw units (a flow setpoint of some thousands): bands in % of span need --op-range
@@ -646,4 +702,42 @@ fn a_weak_cycle_is_an_oscillation_and_said_to_be_weak() {
     let o = &v["oscillation"];
     assert_eq!(o["oscillating"], false, "{o:#}");
     assert!(o.get("weak_cycle").is_none(), "{o:#}");
+}
+
+/// `diagnose --settings`: how diagnose measures and decides, with no file, as text and JSON.
+#[test]
+fn settings_print_the_table_and_the_verdicts_model() {
+    let text = ok(&["diagnose", "--settings"]);
+    for needle in [
+        "[steps]",
+        "[stuck]",
+        "penalty = ",
+        "stiction from P ",
+        "knots",
+    ] {
+        assert!(text.contains(needle), "{needle}: {text}");
+    }
+    let v = json(&ok(&["diagnose", "--settings", "--json"]));
+    assert!(
+        v["settings"]["steps"]["penalty"].as_f64().is_some(),
+        "{v:#}"
+    );
+    let model = &v["model"];
+    let inputs = model["inputs"].as_array().unwrap();
+    assert!(!inputs.is_empty(), "{v:#}");
+    for i in inputs {
+        let name = i["statistic"].as_str().unwrap();
+        assert!(text.contains(name), "{name}: {text}");
+        assert_eq!(
+            i["knots"].as_array().unwrap().len(),
+            i["weights"].as_array().unwrap().len()
+        );
+    }
+    let (below, from) = (
+        model["no_stiction_below"].as_f64().unwrap(),
+        model["stiction_from"].as_f64().unwrap(),
+    );
+    assert!(0.0 < below && below <= from && from < 1.0);
+    // without --settings a file is needed
+    fails(&["diagnose"], &["FILE"]);
 }

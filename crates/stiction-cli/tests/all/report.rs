@@ -73,13 +73,30 @@ fn report_of_a_sticky_loop_is_self_contained() {
         "title with the verdict"
     );
     assert!(html.contains("class=\"verdict v-stiction\""));
-    assert!(html.contains("confidence "));
+    // first the verdict and P, the reasons, the band and the next step; the families folded below
+    assert!(html.contains("P(sticky valve) "));
+    let at = |needle: &str| {
+        html.find(needle)
+            .unwrap_or_else(|| panic!("{needle} not in the page"))
+    };
+    let (why, band, next, trends, folded) = (
+        at("<ul class=\"reasons\">"),
+        at("Stiction band: "),
+        at("<strong>Next step:</strong> "),
+        at("id=\"trends\""),
+        at("<details class=\"family\">"),
+    );
+    assert!(why < band && band < next && next < trends && trends < folded);
+    let reasons = &html[why..html[why..].find("</ul>").unwrap() + why];
+    assert!(reasons.matches("<li>").count() >= 1, "{reasons}");
+    assert!(!html.contains("statistics combined") && !html.contains("trained trees"));
     for name in ["cross_correlation", "curve_fitting", "shape"] {
         assert!(html.contains(&format!("<code>{name}</code>")), "{name}");
     }
     for section in [
         "id=\"trends\"",
         "id=\"phase\"",
+        "id=\"evidence\"",
         "id=\"indices\"",
         "id=\"oscillation\"",
         "id=\"estimates\"",
@@ -92,9 +109,15 @@ fn report_of_a_sticky_loop_is_self_contained() {
     // the estimate, the model overlay, the estimator and the caveat
     assert!(html.contains("Stiction band"));
     assert!(html.contains("Closed-loop fit with and without stiction"));
-    assert!(html.contains("<th>Family</th>"), "the families of evidence");
+    assert!(html.contains("<th>Log-odds</th>"), "the model's reading");
+    for family in ["closed-loop fit", "stick-slip episodes", "linear loop"] {
+        assert!(
+            html.contains(&format!("<span class=\"family-name\">{family}</span>")),
+            "{family}"
+        );
+    }
     // on a phone each row of a wide table is a card, each cell named by its column
-    assert!(html.contains("<td class=\"text\" data-label=\"Why\">"));
+    assert!(html.contains("<td class=\"text\" data-label=\"Threshold\">"));
     assert!(html.contains("table.wide td::before { content: attr(data-label)"));
     assert!(html.contains("% of valve span</strong>"));
     assert!(html.contains("Valve position at the first sample"));

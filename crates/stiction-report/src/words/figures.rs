@@ -26,6 +26,25 @@ pub(crate) fn fig(v: f64) -> String {
     }
 }
 
+/// A figure with two significant digits (`0.0099` → `0.0099`, `0.00999` → `0.01`, `12.3` → `12`).
+pub(crate) fn fig2(v: f64) -> String {
+    if !v.is_finite() || v == 0.0 {
+        return fig(v);
+    }
+    let digits = (1 - v.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let t = format!("{v:.digits$}");
+    let t = if t.contains('.') {
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        t
+    };
+    if t == "-0" {
+        "0".into()
+    } else {
+        t
+    }
+}
+
 /// A share as a percentage (`0.82` → `82 %`).
 pub(crate) fn percent(share: f64) -> String {
     format!("{} %", fig(100.0 * share))
@@ -83,6 +102,9 @@ mod tests {
         assert_eq!(fig(0.0), "0");
         assert_eq!(fig(-0.3), "-0.3");
         assert_eq!(percent(0.823), "82 %");
+        assert_eq!(fig2(0.00999), "0.01");
+        assert_eq!(fig2(0.0412), "0.041");
+        assert_eq!(fig2(12.3), "12");
         assert_eq!(stretch(125.0), "125 min");
         assert_eq!(stretch(1.0), "60 s");
         assert_eq!(stretch(900.0), "15 h");

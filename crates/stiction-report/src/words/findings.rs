@@ -1,7 +1,7 @@
 //! A finding in words, with the record's figures: what was measured and, where its part in the
 //! verdict is known, which way it points.
 
-use super::figures::{fig, percent, stretch, the_cycle, times};
+use super::figures::{fig, fig2, percent, stretch, the_cycle, times};
 use stiction_core::diagnose::{Finding, Reason};
 
 /// Which way a finding points: towards a sticky valve, away from one, or not known (a finding on
@@ -93,11 +93,11 @@ fn sticks_words(sticks: usize, steps: usize, travel: f64, minutes: f64, t: Towar
     match t {
         Towards::Healthy => format!(
             "only {share} in {over} ended a stick (OP moved a median {} % of span while PV stayed in its noise, then PV stepped OP's way)",
-            fig(travel)
+            fig2(travel)
         ),
         _ => format!(
             "OP moved a median {} % of span while PV stayed in its noise, {} in {over}, each time ended by a PV step OP's way ({share})",
-            fig(travel),
+            fig2(travel),
             times(sticks)
         ),
     }
@@ -176,18 +176,15 @@ fn cycle_shape_words(score: f64, period: Option<f64>, t: Towards) -> String {
     };
     if sticky {
         format!(
-            "{cycle} has a sticky valve's shape, triangles or squares rather than a sine (shape score {})",
-            fig(score)
+            "{cycle} has a sticky valve's shape, triangles or squares rather than a sine (shape score {score:.2})"
         )
     } else if score < 0.0 {
         format!(
-            "{cycle} is sinusoidal (shape score {}): a linear cause, not a sticky valve's",
-            fig(score)
+            "{cycle} is sinusoidal (shape score {score:.2}): a linear cause, not a sticky valve's"
         )
     } else {
         format!(
-            "{cycle} is nearer a sine than a sticky valve's triangles or squares (shape score {})",
-            fig(score)
+            "{cycle} is nearer a sine than a sticky valve's triangles or squares (shape score {score:.2})"
         )
     }
 }
