@@ -16,7 +16,7 @@ pub struct Settings {
     pub quantify: bool,
     pub op_range: [f64; 2],
     pub estimate_start: bool,
-    /// The model family's levels test and the hidden-valve family (the CLI's `--thorough`).
+    /// The hidden-valve family (the CLI's `--thorough`).
     pub thorough: bool,
     /// The time column's name, for the sentence when time does not increase.
     pub time_name: String,
@@ -69,12 +69,14 @@ fn diagnose_error(e: DiagnoseError) -> String {
     }
 }
 
-/// Prepare and diagnose one loop: the diagnosis and the prepared record (its signals in time
-/// order, sampling time and notes), or one sentence.
+/// Prepare and diagnose one loop: the diagnosis, its words filled by `stiction-report`'s
+/// `words::fill` (as the CLI fills them), and the prepared record (its signals in time order,
+/// sampling time and notes), or one sentence.
 pub fn run<'a>(signals: Signals<'a>, s: &Settings) -> Result<(Diagnosis, Prepared<'a>), String> {
     let p = record::prepare(signals, s.ts).map_err(|e| prepare_error(e, s))?;
     let req = s.request(p.ts).check().map_err(diagnose_error)?;
-    let d = core::diagnose_checked(&p.signals.record(), &req).map_err(diagnose_error)?;
+    let mut d = core::diagnose_checked(&p.signals.record(), &req).map_err(diagnose_error)?;
+    stiction_report::words::fill(&mut d);
     Ok((d, p))
 }
 

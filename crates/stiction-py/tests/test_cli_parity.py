@@ -30,6 +30,14 @@ def test_diagnose_equals_cli(cli, sticky_csv):
     assert without_seconds(got.to_dict()) == without_seconds(want)
     assert got.verdict == "stiction"
     assert 1.5 < got.band["band_percent_of_span"] < 2.5
+    # P, the reasons and the next step, typed and in the CLI's words
+    assert 0.0 < got.probability <= 1.0
+    assert got.why and all(got.why) and got.why == [r["text"] for r in want["reasons"]]
+    assert all(r["kind"] for r in got.reasons)
+    assert got.next_step["action"] == "travel_test" and got.next_step["text"]
+    read = got.statistics_frame()
+    assert list(read.columns) == ["statistic", "value", "contribution"] and len(read) > 0
+    assert f"P {got.probability:.2f}" in repr(got)
 
 
 def test_diagnose_healthy_equals_cli_with_windows(cli, healthy_csv):
@@ -37,6 +45,9 @@ def test_diagnose_healthy_equals_cli_with_windows(cli, healthy_csv):
     got = stiction.diagnose(pd.read_csv(healthy_csv), sp="sp", window=500, quantify=False)
     assert without_seconds(got.to_dict()) == without_seconds(want)
     assert got.verdict == "no_stiction"
+    w = got.windows
+    assert len(w) == 3 and "probability" in w.columns and "reasons" in w.columns
+    assert all(r["text"] for reasons in w["reasons"] for r in reasons)
     assert abs(got.reach["large_band_percent_of_span"] - 3 * got.reach["small_band_percent_of_span"]) < 1e-9
     assert len(got.windows) == len(want["windows"]) == 3
     assert list(got.windows["verdict"]) == [w["verdict"] for w in want["windows"]]
@@ -66,7 +77,7 @@ def test_estimate_and_simulate_equal_cli(cli, tmp_path):
 
 
 def test_thorough_equals_cli(cli, tmp_path):
-    """thorough=True runs the model family's levels test, as --thorough does."""
+    """thorough=True runs the hidden-valve family, as --thorough does; the words are the CLI's."""
     f = tmp_path / "steps.csv"
     subprocess.run(
         [cli, "simulate", "--loop", "closed", "--param", "d=2", "--samples", "1500", "--noise", "0.05",
@@ -77,7 +88,6 @@ def test_thorough_equals_cli(cli, tmp_path):
     want = run_json(cli, "diagnose", f, "--sp", "sp", "--thorough", "--no-quantify")
     got = stiction.diagnose(pd.read_csv(f), sp="sp", quantify=False, thorough=True)
     assert without_seconds(got.to_dict()) == without_seconds(want)
-    model = next(x for x in want["families"] if x["family"] == "model")
-    assert model["model"]["levels"]["ratio"] >= model["model"]["levels"]["threshold"]
+    assert any(x["family"] == "hidden_valve" for x in want["families"])
     plain = stiction.diagnose(pd.read_csv(f), sp="sp", quantify=False)
-    assert "levels" not in next(x for x in plain.to_dict()["families"] if x["family"] == "model")["model"]
+    assert not any(x["family"] == "hidden_valve" for x in plain.to_dict()["families"])

@@ -20,7 +20,9 @@ def test_rows_ranked_and_a_failing_loop(fleet):
     one = fleet[fleet["loop_id"] == "FIC101"]
     d = stiction.diagnose(one, sp="sp")
     row = out.set_index("loop_id").loc["FIC101"]
-    assert row["verdict"] == d.verdict and row["confidence"] == d.confidence
+    assert row["verdict"] == d.verdict and row["probability"] == d.probability
+    # the reason column: the diagnosis's reasons in words
+    assert row["reason"] == "; ".join(d.why)
     assert row["band_percent_of_span"] == d.band_percent
     # the record's small band, from its OP noise, as the diagnosis reports it
     assert row["small_band_percent_of_span"] == d.reach["small_band_percent_of_span"] > 0

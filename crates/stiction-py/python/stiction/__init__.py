@@ -63,8 +63,9 @@ def diagnose(
     estimate_start: bool = False,
     thorough: bool = False,
 ) -> Diagnosis:
-    """Diagnose one loop from routine data: quality gates, oscillation, the families of evidence
-    (valve, closed-loop fit, stick-slip, shape, loop) and a verdict, as ``stiction diagnose``.
+    """Diagnose one loop from routine data, as ``stiction diagnose``: quality gates, the
+    families of evidence (valve, closed-loop fit, stick-slip, shape, loop), the probability of a
+    sticky valve from one calibrated model, the verdict with its reasons and next step in words.
 
     data: a DataFrame whose columns ``op``, ``pv`` (and ``sp``, ``mode``, ``mv`` if given) name
         the signals; its DatetimeIndex, or a column ``time`` / t / time / timestamp, gives the
@@ -77,12 +78,10 @@ def diagnose(
     window: also a verdict per window of this many samples (``Diagnosis.windows``).
     quantify: size the band with the closed-loop estimate when the verdict is stiction.
     op_range: OP of a closed and a fully open valve; the band is in % of this span.
-    thorough: the closed-loop fit also runs the levels test (every distinct Stenman valve scored
-        on PV's levels): more sticky valves found on records sampled at every controller
-        execution, at 1 to 3 s a loop of 2,000 samples; where no family has decided stiction on
-        a limit cycle, also the hidden-valve family (a particle filter over a valve that slips
-        between the samples; about 1 s more on two cores, 3 s where it votes stiction: the
-        median of three draws).
+    thorough: also the hidden-valve family (a particle filter over a sticky valve that slips
+        between the samples, on a loop that oscillates; about 1 s more on two cores, 3 s where
+        it finds one: the median of three draws); it reports beside the verdict, which does not
+        read it.
 
     Missing values (NaN, None, historian states such as "Bad Input") are gaps.
     """

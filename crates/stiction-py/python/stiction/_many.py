@@ -17,7 +17,7 @@ FLEET_COLUMNS = [
     "loop_id",
     "source",
     "verdict",
-    "confidence",
+    "probability",
     "severity",
     "band_percent_of_span",
     "band_source",
@@ -102,7 +102,7 @@ def diagnose_many(
     parallel in Rust with the GIL released, on a pool of ``threads`` (default: one per core).
 
     Returns one row per loop (columns :data:`MANY_COLUMNS`: ``stiction batch``'s summary),
-    ranked as ``batch`` ranks: severity (band x confidence) first, then the verdict, then the
+    ranked as ``batch`` ranks: severity (band x the probability of a sticky valve) first, then the verdict, then the
     loop id. A loop that cannot be read or diagnosed is a ``failed`` row with its reason; the
     others go on. The result does not depend on ``threads`` (only ``seconds``, the time each
     diagnosis took, varies). Time: the ``time`` column, else a DatetimeIndex, else a column

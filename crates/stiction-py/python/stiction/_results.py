@@ -44,23 +44,31 @@ class Diagnosis(_Result):
     """The diagnosis of one loop (``stiction diagnose --json``).
 
     Main attributes: ``verdict`` (``stiction``, ``no_stiction``, ``undetermined``,
-    ``insufficient_data``), ``confidence``, ``reason``, ``next_step``, ``band`` (the stiction band
-    in % of valve span and where it comes from, for a ``stiction`` verdict), ``reach`` (the bands
-    the record hides, from OP's noise: what a ``no_stiction`` verdict says little about),
-    ``families`` (the
-    evidence and their votes), ``combined`` (the families' statistics read together by trained
-    trees: ``probability`` of a sticky valve, ``decided`` when they turned the verdict to
-    ``stiction``, each statistic's ``contribution``), ``indices`` (the shape indices), ``oscillation``, ``quality``
-    (the data-quality gates), ``samples``, ``ts``, ``warnings``; without a setpoint column,
-    ``setpoint_read_off`` (the setpoint's steps read off OP and PV, and the levels between) when
-    any were found.
+    ``insufficient_data``), ``probability`` (of a sticky valve, from the verdict's one calibrated
+    model; None where the record could not be judged), ``reasons`` (the one or two findings that
+    decided the verdict: each a dict with its ``kind``, its figures, its ``contribution`` to the
+    log-odds and its ``text`` in words), ``next_step`` (a dict: ``action``, its qualifiers and its
+    ``text``), ``statistics`` (the model's reading: each statistic's ``value`` and
+    ``contribution``), ``band`` (the stiction band in % of valve span and where it comes from, for
+    a ``stiction`` verdict), ``reach`` (the bands the record hides, from OP's noise: what a
+    ``no_stiction`` verdict says little about), ``families`` (the evidence, each with its vote and
+    its ``contribution`` to the log-odds), ``indices`` (the shape indices), ``oscillation``,
+    ``quality`` (the data-quality gates), ``samples``, ``ts``, ``warnings``; without a setpoint
+    column, ``setpoint_read_off`` (the setpoint's steps read off OP and PV, and the levels
+    between) when any were found. The words are the CLI's (the same Rust code fills them).
     """
 
     @property
+    def why(self) -> List[str]:
+        """The reasons in words, the one or two findings that decided the verdict."""
+        return [r.get("text", "") for r in self._d.get("reasons") or []]
+
+    @property
     def windows(self) -> pd.DataFrame:
-        """The verdict per window (``window=`` samples) as a DataFrame; empty without windows."""
+        """The verdict per window (``window=`` samples) as a DataFrame; empty without windows.
+        Its ``reasons`` are the window's reasons (dicts, each with its ``text``)."""
         rows = self._d.get("windows") or []
-        return pd.DataFrame(rows, columns=None if rows else ["start", "end", "t_start", "t_end", "verdict", "confidence", "reason", "period", "votes"])
+        return pd.DataFrame(rows, columns=None if rows else ["start", "end", "t_start", "t_end", "verdict", "probability", "reasons", "period", "votes"])
 
     @property
     def band_percent(self) -> Any:
@@ -72,12 +80,18 @@ class Diagnosis(_Result):
         """The shape indices (name, value, vote, threshold, ...) as a DataFrame."""
         return pd.DataFrame(self._d.get("indices") or [])
 
+    def statistics_frame(self) -> pd.DataFrame:
+        """The verdict model's reading (statistic, value, contribution to the log-odds) as a
+        DataFrame; empty where the record could not be judged."""
+        s = self._d.get("statistics") or {}
+        return pd.DataFrame(s.get("contributions") or [], columns=["statistic", "value", "contribution"])
+
     def __repr__(self) -> str:
-        c = self._d.get("confidence")
-        conf = "" if c is None else f", confidence {c:.2f}"
+        p = self._d.get("probability")
+        prob = "" if p is None else f", P {p:.2f}"
         band = self.band_percent
         b = "" if band is None else f", band {band:.2f} % of span"
-        return f"<Diagnosis {self._d.get('verdict')}{conf}{b}; {self._d.get('samples')} samples>"
+        return f"<Diagnosis {self._d.get('verdict')}{prob}{b}; {self._d.get('samples')} samples>"
 
 
 class Quantification(_Result):

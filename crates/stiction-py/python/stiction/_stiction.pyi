@@ -27,8 +27,13 @@ def diagnose(
     quantify: bool = True,
     op_range: Tuple[float, float] = (0.0, 100.0),
     estimate_start: bool = False,
+    thorough: bool = False,
     time_name: Optional[str] = None,
-) -> Tuple[str, List[str]]: ...
+) -> Tuple[str, List[str]]:
+    """Diagnose one loop: the Diagnosis as the CLI's ``diagnose --json`` text (the reasons' and
+    the next step's ``text`` filled by the same words), and the notes of the record's
+    preparation."""
+
 def report(
     op: npt.NDArray[np.float64],
     pv: npt.NDArray[np.float64],
@@ -42,6 +47,7 @@ def report(
     quantify: bool = True,
     op_range: Tuple[float, float] = (0.0, 100.0),
     estimate_start: bool = False,
+    thorough: bool = False,
     time_name: Optional[str] = None,
     loop_id: str = "loop",
     columns: Optional[Dict[str, str]] = None,
@@ -66,11 +72,14 @@ def diagnose_many(
     quantify: bool = True,
     op_range: Tuple[float, float] = (0.0, 100.0),
     estimate_start: bool = False,
+    thorough: bool = False,
     time_name: Optional[str] = None,
     threads: Optional[int] = None,
     progress: bool = False,
     failed: Optional[Dict[int, str]] = None,
-) -> str: ...
+) -> str:
+    """Diagnose many loops: the ranked fleet rows as JSON (``stiction batch``'s summary rows:
+    ``probability`` of a sticky valve, ``reason`` the reasons' words joined by "; ")."""
 def quantify(
     op: npt.NDArray[np.float64],
     pv: npt.NDArray[np.float64],

@@ -31,7 +31,7 @@ def schema(by_field: Any) -> Any:
     kinds = {
         "source": StringType(),
         "verdict": StringType(),
-        "confidence": DoubleType(),
+        "probability": DoubleType(),
         "severity": DoubleType(),
         "band_percent_of_span": DoubleType(),
         "band_source": StringType(),
