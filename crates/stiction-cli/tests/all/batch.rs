@@ -112,7 +112,12 @@ fn a_folder_is_ranked_with_the_bad_loop_failed_and_the_rest_diagnosed() {
     assert_eq!(rows[0]["samples"], "1500");
     assert_eq!(rows[0]["error"], "");
     assert_eq!(rows[1]["loop_id"], "healthy");
-    assert_eq!(rows[1]["verdict"], "no_stiction");
+    // judged and not sticky (no_stiction or undetermined: the model's to say)
+    assert!(
+        ["no_stiction", "undetermined"].contains(&rows[1]["verdict"].as_str()),
+        "{:?}",
+        rows[1]
+    );
     assert_eq!(rows[1]["severity"], "0");
     assert_eq!(rows[1]["error"], "");
     assert!(!rows[1]["reason"].is_empty());
@@ -255,7 +260,11 @@ fn a_long_format_file_is_streamed_loop_by_loop() {
         rows[0]["source"],
         format!("{} lines 2-1501", file.display())
     );
-    assert_eq!(rows[1]["verdict"], "no_stiction");
+    assert!(
+        ["no_stiction", "undetermined"].contains(&rows[1]["verdict"].as_str()),
+        "{:?}",
+        rows[1]
+    );
     // the error names the long file and its own line
     let bad_line = first_line["bad"] + 40;
     let err = &rows[2]["error"];

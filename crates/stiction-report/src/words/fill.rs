@@ -3,7 +3,7 @@
 
 use super::findings::{reason, words, Towards};
 use super::next_step::next_step;
-use stiction_core::diagnose::{Diagnosis, Finding, Reading, Reason, Statistic};
+use stiction_core::diagnose::{Diagnosis, Finding, Reading, Reason, Statistic, VerdictModel};
 
 /// Fill every `text` of `d`: its reasons', each window's reasons' and its next step's. Call it
 /// right after `diagnose`, before printing, serialising or building fleet rows from `d`;
@@ -51,10 +51,16 @@ fn measures(s: Statistic) -> &'static str {
     }
 }
 
-/// What the reading measured, each once, in the model's order.
+/// What the reading measured of what the model reads, each once, in the model's order.
 fn measured(reading: &Reading) -> Vec<&'static str> {
+    let model = VerdictModel::embedded();
+    let read = |s: Statistic| model.inputs.iter().any(|i| i.statistic == s);
     let mut out: Vec<&'static str> = Vec::new();
-    for c in reading.contributions.iter().filter(|c| c.value.is_some()) {
+    for c in reading
+        .contributions
+        .iter()
+        .filter(|c| c.value.is_some() && read(c.statistic))
+    {
         let m = measures(c.statistic);
         if !out.contains(&m) {
             out.push(m);
@@ -105,11 +111,22 @@ mod tests {
             ],
         };
         let r = Reason::plain(Finding::NothingOfAStickyValve);
-        assert_eq!(
-            reason_in(&r, Some(&reading)),
-            "no statistic points to a sticky valve: of what was measured (PV's steps and the \
-             closed-loop fit), none moves the odds towards one"
+        let text = reason_in(&r, Some(&reading));
+        assert!(
+            text.starts_with("no statistic points to a sticky valve"),
+            "{text}"
         );
+        // only what was measured and the model reads is named; the cycle was not measured
+        assert!(!text.contains("cycle"), "{text}");
+        let read = |s: Statistic| {
+            VerdictModel::embedded()
+                .inputs
+                .iter()
+                .any(|i| i.statistic == s)
+        };
+        if read(Statistic::StickShare) {
+            assert!(text.contains("PV's steps"), "{text}");
+        }
         assert_eq!(list(&["a", "b", "c"]), "a, b and c");
     }
 }

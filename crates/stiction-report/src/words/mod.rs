@@ -18,7 +18,7 @@ pub use fill::fill;
 pub use findings::{finding, reason};
 pub use next_step::{action, next_step};
 pub use reach::reach;
-pub use statistics::{statistic, statistic_value};
+pub use statistics::{measured_by, statistic, statistic_value};
 
 use stiction_core::diagnose::{Verdict, Vote};
 use stiction_core::fleet::Outcome;

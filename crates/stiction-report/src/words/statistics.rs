@@ -2,7 +2,17 @@
 //! model reads some through `ln(1 + x)`; these words undo it).
 
 use super::figures::{fig, percent};
-use stiction_core::diagnose::Statistic;
+use stiction_core::diagnose::{Family, Statistic};
+
+/// The family that measures a statistic.
+pub fn measured_by(s: Statistic) -> Family {
+    match s {
+        Statistic::StickShare | Statistic::Sticks | Statistic::Stuck => Family::StickSlip,
+        Statistic::FitGain | Statistic::FitBand | Statistic::FitTest => Family::Model,
+        Statistic::CycleShape => Family::Shape,
+        Statistic::LoopLag => Family::Loop,
+    }
+}
 
 /// A statistic's name in words.
 pub fn statistic(s: Statistic) -> &'static str {

@@ -52,37 +52,63 @@ pub struct Evidence {
     pub no_index: Option<&'static str>,
 }
 
-/// A share of the log-odds as the page prints it: `+1.2`, `−0.4`, `0`.
-fn log_odds(c: f64) -> String {
+/// A share of the log-odds as the page prints it: `+1.24`, `−0.42`, `0`.
+pub(super) fn log_odds(c: f64) -> String {
     if c.abs() < 0.005 {
         "0".into()
-    } else if c > 0.0 {
-        format!("+{}", num(c))
     } else {
-        num(c)
+        format!("{c:+.2}").replace('-', "−")
     }
 }
 
+fn way(c: f64) -> &'static str {
+    match c {
+        x if x >= 0.005 => "towards",
+        x if x <= -0.005 => "away",
+        _ => "none",
+    }
+}
+
+/// The statistics the model reads, each with its value and share of the log-odds, then the
+/// model's base and the total.
 fn statistic_rows(d: &Diagnosis) -> Vec<StatisticRow> {
     let Some(reading) = &d.statistics else {
         return Vec::new();
     };
-    reading
+    let model = VerdictModel::embedded();
+    let read = |s| model.inputs.iter().any(|i| i.statistic == s);
+    let mut rows: Vec<StatisticRow> = reading
         .contributions
         .iter()
+        .filter(|c| read(c.statistic))
         .map(|c| StatisticRow {
             name: words::statistic(c.statistic),
             value: c.value.map_or("not measured".into(), |v| {
                 words::statistic_value(c.statistic, v)
             }),
             contribution: log_odds(c.contribution),
-            way: match c.contribution {
-                x if x >= 0.005 => "towards",
-                x if x <= -0.005 => "away",
-                _ => "none",
-            },
+            way: way(c.contribution),
         })
-        .collect()
+        .collect();
+    let total = model.intercept
+        + reading
+            .contributions
+            .iter()
+            .map(|c| c.contribution)
+            .sum::<f64>();
+    rows.push(StatisticRow {
+        name: "base (every statistic at a healthy record's value)",
+        value: String::new(),
+        contribution: log_odds(model.intercept),
+        way: way(model.intercept),
+    });
+    rows.push(StatisticRow {
+        name: "in all: the log-odds of a sticky valve",
+        value: format!("P = {:.2}", reading.probability),
+        contribution: log_odds(total),
+        way: way(total),
+    });
+    rows
 }
 
 fn model_words(d: &Diagnosis) -> String {
@@ -107,7 +133,30 @@ fn model_words(d: &Diagnosis) -> String {
     }
 }
 
-fn family_block(f: &FamilyEvidence) -> FamilyBlock {
+fn family_block(f: &FamilyEvidence, d: &Diagnosis) -> FamilyBlock {
+    let mut rows = details::rows(f);
+    if let Some(reading) = &d.statistics {
+        let model = VerdictModel::embedded();
+        let parts: Vec<String> = reading
+            .contributions
+            .iter()
+            .filter(|c| words::measured_by(c.statistic) == f.family)
+            .filter(|c| model.inputs.iter().any(|i| i.statistic == c.statistic))
+            .map(|c| {
+                format!(
+                    "{} {}: {}",
+                    words::statistic(c.statistic),
+                    c.value.map_or("not measured".into(), |v| {
+                        words::statistic_value(c.statistic, v)
+                    }),
+                    log_odds(c.contribution)
+                )
+            })
+            .collect();
+        if !parts.is_empty() {
+            rows.insert(0, kv("In the verdict's model", parts.join("; ")));
+        }
+    }
     FamilyBlock {
         family: f.family.words(),
         vote: vote_chip(f.vote),
@@ -115,7 +164,7 @@ fn family_block(f: &FamilyEvidence) -> FamilyBlock {
             .contribution
             .map(|c| format!("{} to the log-odds", log_odds(c))),
         note: f.note.clone(),
-        rows: details::rows(f),
+        rows,
     }
 }
 
@@ -141,7 +190,7 @@ pub fn evidence(d: &Diagnosis) -> Evidence {
         model: model_words(d),
         vote: num(stiction_core::diagnose::VOTE),
         statistics: statistic_rows(d),
-        families: d.families.iter().map(family_block).collect(),
+        families: d.families.iter().map(|f| family_block(f, d)).collect(),
         indices,
         no_index,
     }
