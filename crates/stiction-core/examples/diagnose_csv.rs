@@ -53,15 +53,16 @@ fn main() -> Result<(), Box<dyn Error>> {
     // the defaults: sampled every second, OP in % of the valve's span, the band estimated too
     let d = diagnose(&record, &DiagnoseRequest::default())?;
     println!("{path}: {}", d.verdict);
-    if let Some(c) = d.confidence {
-        println!("  confidence {c:.2}");
+    if let Some(p) = d.probability {
+        println!("  probability of a sticky valve {p:.2}");
     }
     if let Some(band) = &d.band {
         println!("  stiction band {:.2} % of span", band.band_percent_of_span);
     }
-    if let Some(reason) = &d.reason {
-        println!("  why: {reason}");
+    // the reasons and the next step are typed; stiction-report words them for people
+    for r in &d.reasons {
+        println!("  why: {:?}", r.finding);
     }
-    println!("  next step: {}", d.next_step);
+    println!("  next step: {:?}", d.next_step.action);
     Ok(())
 }

@@ -4,7 +4,7 @@
 //! sinusoid at that period, or tuned to its stability limit, does not.
 
 use stiction_core::diagnose::{
-    diagnose, BandSource, DiagnoseRequest, Diagnosis, Family, FamilyEvidence, Verdict, Vote,
+    diagnose, DiagnoseRequest, Diagnosis, Family, FamilyEvidence, Verdict, Vote,
 };
 use stiction_core::models::{Model, Stenman};
 use stiction_core::sim::{ClosedLoop, LoopData, Pi, Process, Signal};
@@ -49,7 +49,7 @@ fn loop_family(d: &Diagnosis) -> &FamilyEvidence {
 }
 
 #[test]
-fn a_fast_sticky_loop_is_called_sticky_with_its_describing_function_band() {
+fn a_fast_sticky_loops_limit_cycle_needs_the_valves_lag_and_its_describing_function_band() {
     let d = judge(&fast_loop(2.0, 1.3, None));
     let period = d.oscillation.as_ref().and_then(|o| o.period).unwrap();
     assert!((90.0..150.0).contains(&period), "period {period}");
@@ -71,14 +71,11 @@ fn a_fast_sticky_loop_is_called_sticky_with_its_describing_function_band() {
     // is within about a third of the observed one here
     let predicted = df.predicted_period.unwrap();
     assert!((predicted / period - 1.0).abs() < 0.4, "{df:?}");
-    assert_eq!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
-    let band = d.band.as_ref().unwrap();
-    let beside = band
-        .others
-        .iter()
-        .find(|(s, _)| *s == BandSource::DescribingFunction)
-        .map(|(_, v)| *v);
-    assert_eq!(beside, Some(df.band_percent_of_span), "{band:?}");
+    // the lag the loop needs moves the verdict's model towards a sticky valve; on its own, here,
+    // not past its threshold (a regular cycle gives no sticks and fits alike with and without a
+    // band)
+    assert!(f.contribution.is_some_and(|c| c > 0.0), "{f:?}");
+    assert_ne!(d.verdict, Verdict::NoStiction, "{:?}", d.reasons);
 }
 
 #[test]
@@ -97,7 +94,7 @@ fn an_external_sinusoid_at_the_loops_period_is_not_stiction() {
             "{}",
             loop_family(&d).note
         );
-        assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+        assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.reasons);
     }
 }
 
@@ -109,7 +106,7 @@ fn a_loop_tuned_to_its_stability_limit_is_not_stiction() {
     assert_ne!(f.vote, Vote::Stiction, "{}", f.note);
     let e = f.limit_cycle.as_ref().unwrap();
     assert!(e.needed_lag_degrees.abs() < 10.0, "{e:?}");
-    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.evidence);
+    assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.reasons);
 }
 
 #[test]

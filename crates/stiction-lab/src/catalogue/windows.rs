@@ -99,7 +99,7 @@ fn tune(class: LoopClass, lin: &LinearLoop, d: &mut Draw) -> (Pi, Tuning) {
 }
 
 /// Operator setpoint moves: a few single steps or staircases (2-4 steps the same way, a minute
-/// or a few apart) at random times, each step 0.2-3 % of the PV's scale.
+/// or a few apart) at random times, each step 0.3-8 % of the PV's scale (large steps on quiet PVs are common on a real plant).
 fn operator_setpoint(total: f64, warmup: f64, d: &mut Draw) -> (Signal, usize) {
     let dt = 1.0;
     let n = (total / dt) as usize + 2;
@@ -111,7 +111,7 @@ fn operator_setpoint(total: f64, warmup: f64, d: &mut Draw) -> (Signal, usize) {
         let sign = if d.chance(0.5) { 1.0 } else { -1.0 };
         let count = d.weighted(&[(1usize, 0.55), (2, 0.2), (3, 0.15), (4, 0.1)]);
         for _ in 0..count {
-            let size = sign * d.log_uniform(0.2, 3.0);
+            let size = sign * d.log_uniform(0.3, 8.0);
             let from = ((at / dt) as usize).min(n);
             sp[from..].iter_mut().for_each(|v| *v += size);
             steps += 1;

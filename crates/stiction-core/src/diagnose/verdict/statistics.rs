@@ -5,6 +5,10 @@ use super::{Motion, Statistic};
 use crate::diagnose::evidence::{Family, FamilyEvidence, ModelEvidence, StickSlipEvidence};
 use crate::diagnose::reasons::Finding;
 
+/// Below this share of PV's variation above its noise explained through any valve, OP does not
+/// drive PV's cycle.
+const MIN_EXPLAINED: f64 = 0.3;
+
 /// The statistics of one judged stretch (`None`: not measured there).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Measured([Option<f64>; Statistic::ALL.len()]);
@@ -27,17 +31,25 @@ impl Measured {
         let op_noise = op_noise.max(1e-9);
         let finite = |v: f64| v.is_finite().then_some(v);
         let mut m = Measured::default();
+        // OP drives PV: the fit explains enough of PV's variation through some valve
+        let driven = fit(families).is_none_or(|e| e.explained >= MIN_EXPLAINED);
         for (i, s) in Statistic::ALL.into_iter().enumerate() {
             let st = sticks(families);
             let ft = fit(families).filter(|e| e.judged);
             m.0[i] = match s {
-                Statistic::StickShare => st.map(|e| e.stick_share),
+                // (as the cycle's shape: a PV that steps while OP winds, where OP does not drive
+                // PV, steps OP's way by chance)
+                Statistic::StickShare => st.map(|e| e.stick_share).filter(|_| driven),
                 Statistic::Sticks => st.map(|e| (e.sticks as f64).ln_1p()),
                 Statistic::Stuck => st.map(|e| e.stuck_travel_percent_of_span.ln_1p()),
                 Statistic::FitGain => ft.map(|e| e.improvement.max(0.0)),
                 Statistic::FitBand => ft.map(|e| (e.stenman_d / op_noise).ln_1p()),
                 Statistic::FitTest => ft.map(|e| e.significance.max(0.0).ln_1p()),
-                Statistic::CycleShape => family(families, Family::Shape).and_then(|f| f.value),
+                // a cycle OP does not drive (the fit explains little of PV through any valve) has
+                // no valve's shape: its shape is not read
+                Statistic::CycleShape => family(families, Family::Shape)
+                    .and_then(|f| f.value)
+                    .filter(|_| driven),
                 Statistic::LoopLag => family(families, Family::Loop).and_then(|f| f.value),
             }
             .and_then(finite);

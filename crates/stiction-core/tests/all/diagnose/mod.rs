@@ -3,11 +3,8 @@
 
 mod record;
 mod shape;
-mod thorough;
 
-use stiction_core::diagnose::{
-    diagnose, DiagnoseRequest, Family, LoopRecord, Thresholds, Verdict, Vote,
-};
+use stiction_core::diagnose::{diagnose, DiagnoseRequest, Family, LoopRecord, Verdict, Vote};
 use stiction_core::models::{Model, Stenman};
 use stiction_core::quality::Gate;
 use stiction_core::sim::{ClosedLoop, LoopData, Process, Signal};
@@ -83,11 +80,4 @@ fn model_family(
     d: &stiction_core::diagnose::Diagnosis,
 ) -> &stiction_core::diagnose::evidence::FamilyEvidence {
     family_of(d, Family::Model)
-}
-
-/// The hidden-valve family's evidence of a thorough diagnosis.
-fn hidden_valve_of(
-    d: &stiction_core::diagnose::Diagnosis,
-) -> &stiction_core::diagnose::evidence::FamilyEvidence {
-    family_of(d, Family::HiddenValve)
 }
