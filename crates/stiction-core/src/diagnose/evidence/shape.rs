@@ -16,13 +16,6 @@ use crate::spectral::{self, BicoherenceSettings};
 /// The shape family.
 pub struct Shape;
 
-/// Least weighted share of the counted indices behind a stiction vote.
-const MIN_SUPPORT: f64 = 0.7;
-
-/// Strength of a vote against stiction from the shape of an oscillation: a near-sinusoidal cycle
-/// is what a linear loop gives, but also a sticky valve whose sticks are shorter than a sample.
-const AGAINST_STRENGTH: f64 = 0.5;
-
 impl EvidenceFamily for Shape {
     fn family(&self) -> Family {
         Family::Shape
@@ -31,11 +24,9 @@ impl EvidenceFamily for Shape {
     fn evaluate(&self, ctx: &Context) -> FamilyEvidence {
         let osc = &ctx.oscillation;
         let threshold = format!(
-            "the indices' weighted vote: stiction at {m} or above with {:.0} % of the counted indices behind it, unless PV is compressed in over \
-             {:.0} % of the oscillating stretch; none at -{m} or below",
-            100.0 * MIN_SUPPORT,
-            100.0 * ctx.req.limits.repeated_share,
-            m = ctx.req.verdict_margin
+            "read by the verdict's model: the indices' weighted vote, -1 (sinusoidal) to 1 (a sticky valve's shape), not read where PV is compressed in over \
+             {:.0} % of the oscillating stretch and the shape points to a valve",
+            100.0 * ctx.req.limits.repeated_share
         );
         let statistic = "weighted vote of the shape indices (-1 none, +1 stiction)";
         let periods = osc.periods_in_record.unwrap_or(0.0);
@@ -69,23 +60,14 @@ impl EvidenceFamily for Shape {
             ctx.req.ts,
             ctx.req.integrating,
         );
-        let (mut vote, score, support) = combine(&idx, ctx.req.verdict_margin);
-        // a stiction vote needs most of the counted indices behind it (calibration: one index
-        // alone calls too many disturbed and compressed loops sticky)
-        if vote == Vote::Stiction && support < MIN_SUPPORT {
-            vote = Vote::Undetermined;
-        }
+        let (_, score, _) = combine(&idx, ctx.req.verdict_margin);
         // a compressed PV (repeats, or exactly straight lines between stored points, in more of
         // the stretch than the quality gate allows) is the historian's drawing: the kinks and
-        // ramps the indices read as a valve's are the compression's. On the plant benchmark's
-        // catalogue this moved four healthy level loops from `undetermined` to `no_stiction`
-        // and nothing else, nor anything on the ISDB; a vote against stiction still holds
-        // (compression makes a cycle look less sinusoidal, not more)
+        // ramps the indices read as a valve's are the compression's, and a shape that points to a
+        // valve is not read (one that points away still is: compression makes a cycle look less
+        // sinusoidal, not more)
         let compressed = ctx.unrecorded_share(s, e);
-        let drawn = vote == Vote::Stiction && compressed > ctx.req.limits.repeated_share;
-        if drawn {
-            vote = Vote::Undetermined;
-        }
+        let drawn = score > 0.0 && compressed > ctx.req.limits.repeated_share;
         let note = idx
             .iter()
             .filter(|i| i.weight > 0.0 && (i.only_votes.is_none() || i.vote != Vote::Undetermined))
@@ -105,14 +87,10 @@ impl EvidenceFamily for Shape {
         let _ = ctx.indices.set(idx);
         FamilyEvidence {
             family: Family::Shape,
-            vote,
-            strength: match vote {
-                Vote::Stiction => support,
-                Vote::NoStiction => AGAINST_STRENGTH * support,
-                Vote::Undetermined => 0.0,
-            },
+            vote: Vote::Undetermined,
+            strength: 0.0,
             contribution: None,
-            value: Some(score),
+            value: (!drawn).then_some(score),
             statistic: statistic.into(),
             threshold,
             note: format!(
@@ -122,7 +100,7 @@ impl EvidenceFamily for Shape {
                 if drawn {
                     format!(
                         "; but PV repeats itself or runs in exactly straight lines in {:.0} % of the oscillating stretch (historian compression): \
-                         the shape the indices read is the compression's, so this is no vote",
+                         the shape the indices read is the compression's, so it is not read",
                         100.0 * compressed
                     )
                 } else {

@@ -282,6 +282,10 @@ fn next_step(
         .any(|c| c.statistic == Statistic::CycleShape && c.contribution <= -VOTE);
     let action = match verdict {
         Verdict::Stiction => Action::TravelTest,
+        // a cycle of a few samples hides a valve's sticks from every family
+        Verdict::NoStiction | Verdict::Undetermined if motion.unresolved_cycle.is_some() => {
+            Action::SampleFaster
+        }
         Verdict::NoStiction if sinusoidal => Action::CheckTuning,
         // nearer the undetermined band than to a clear healthy valve
         Verdict::NoStiction if p >= model.no_stiction_below / 2.0 => Action::NoActionWeak,
@@ -296,7 +300,9 @@ fn next_step(
         pv_not_recorded: motion
             .pv_not_recorded
             .filter(|_| verdict != Verdict::Stiction),
-        sample_every: None,
+        sample_every: (action == Action::SampleFaster)
+            .then(|| motion.unresolved_cycle.map(|(period, _)| period / 10.0))
+            .flatten(),
         text: String::new(),
     }
 }
