@@ -17,7 +17,6 @@ use stiction_lab::catalogue_loop;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::time::Instant;
-use stiction_core::diagnose::Thresholds;
 use stiction_core::diagnose::{diagnose, Verdict};
 use stiction_core::hidden_valve::{test, Particles, Record, TestSettings};
 use stiction_lab::catalogue::{catalogue, BenchmarkLoop, Set, Suite, Truth};
@@ -33,6 +32,17 @@ struct Judged {
 }
 
 const THRESHOLDS: [f64; 4] = [10.0, 20.0, 30.0, 50.0];
+
+/// The hidden-valve family of `diagnose --thorough` as it stood when the verdict's rules used
+/// its vote (before issue 69's calibrated verdict; the family now reports and decides nothing):
+/// 50 particles, a stiction vote from a ratio of 75, the median of 3 draws of the particle
+/// filter's noise. The particle count is this study's default (`--particles`); the threshold
+/// and the draws are quoted in its header.
+const FAMILY_PARTICLES: usize = 50;
+/// The ratio from which the family voted stiction (see [`FAMILY_PARTICLES`]).
+const FAMILY_THRESHOLD: f64 = 75.0;
+/// The draws of the particle filter's noise whose median the family's vote read.
+const FAMILY_DRAWS: u64 = 3;
 
 fn judge(l: &BenchmarkLoop, particles: usize, sticky_starts: usize) -> Judged {
     let start = Instant::now();
@@ -86,10 +96,8 @@ fn main() {
         Some("routine") => Suite::Routine,
         _ => Suite::Fast,
     };
-    let particles: usize = arg(&args, "--particles")
-        .map_or(Thresholds::default().hidden_valve_particles, |v| {
-            v.parse().expect("--particles N")
-        });
+    let particles: usize =
+        arg(&args, "--particles").map_or(FAMILY_PARTICLES, |v| v.parse().expect("--particles N"));
     let sticky_starts: usize =
         arg(&args, "--sticky-starts").map_or(2, |v| v.parse().expect("--sticky-starts N"));
     let only: Vec<&String> = args
@@ -109,13 +117,16 @@ fn main() {
          ({particles} particles). The ratio (natural log) of a Stenman valve whose position the record does not hold \
          against a valve that follows OP, each hypothesis's loop model found by coordinate ascent from four processes \
          (see `stiction_core::hidden_valve`), beside `diagnose`'s verdict as the CLI gives it (without `--thorough`). The study behind \
-         `diagnose --thorough`'s hidden-valve family, which votes on the ratio from {:.0} where its gates let it judge.\n",
+         `diagnose --thorough`'s hidden-valve family, which voted stiction from a ratio of {:.0} (the median of {} draws \
+         of the particle filter's noise) where its gates let it judge, until the calibrated verdict of issue 69; it now \
+         reports and decides nothing.\n",
         if arg(&args, "--set") == Some("calibration") {
             " --set calibration"
         } else {
             ""
         },
-        Thresholds::default().hidden_valve_threshold,
+        FAMILY_THRESHOLD,
+        FAMILY_DRAWS,
     );
     let sets = match arg(&args, "--set") {
         Some("calibration") => vec![Set::Calibration],
