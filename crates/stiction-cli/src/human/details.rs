@@ -4,10 +4,25 @@
 
 use stiction_core::diagnose::{Diagnosis, Vote};
 
-/// A share of the log-odds, signed (`+1.20`), or `-` where the model reads none of a family's
-/// statistics.
+/// A share of the log-odds, signed (`+1.20`; `0.00` for less than half a hundredth either
+/// way), or `-` where the model reads none of a family's statistics.
 fn log_odds(c: Option<f64>) -> String {
-    c.map_or("-".into(), |c| format!("{c:+.2}"))
+    match c {
+        None => "-".into(),
+        Some(c) if c.abs() < 0.005 => "0.00".into(),
+        Some(c) => format!("{c:+.2}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shares_of_the_log_odds_are_signed_and_never_minus_zero() {
+        assert_eq!(super::log_odds(Some(1.204)), "+1.20");
+        assert_eq!(super::log_odds(Some(-0.42)), "-0.42");
+        assert_eq!(super::log_odds(Some(-0.001)), "0.00");
+        assert_eq!(super::log_odds(None), "-");
+    }
 }
 
 /// Print the details block.
