@@ -14,17 +14,6 @@ fn log_odds(c: Option<f64>) -> String {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn shares_of_the_log_odds_are_signed_and_never_minus_zero() {
-        assert_eq!(super::log_odds(Some(1.204)), "+1.20");
-        assert_eq!(super::log_odds(Some(-0.42)), "-0.42");
-        assert_eq!(super::log_odds(Some(-0.001)), "0.00");
-        assert_eq!(super::log_odds(None), "-");
-    }
-}
-
 /// Print the details block.
 pub fn print(d: &Diagnosis) {
     if d.families.is_empty() && d.indices.is_empty() {
@@ -99,5 +88,16 @@ fn indices(d: &Diagnosis) {
                 ""
             }
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shares_of_the_log_odds_are_signed_and_never_minus_zero() {
+        assert_eq!(super::log_odds(Some(1.204)), "+1.20");
+        assert_eq!(super::log_odds(Some(-0.42)), "-0.42");
+        assert_eq!(super::log_odds(Some(-0.001)), "0.00");
+        assert_eq!(super::log_odds(None), "-");
     }
 }
