@@ -146,7 +146,14 @@ fn training(plan: &Plan, train: &[Sample], extra: u8, md: &str) -> Training {
         .lines()
         .find(|l| l.starts_with("| all |"))
         .map_or("no real records".into(), |l| {
-            format!("real records out of fold (leave one loop out): {l}")
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            format!(
+                "the {} real records out of fold (leave one loop out): balanced accuracy {} (sensitivity {}, specificity {}); the tables: crates/stiction-lab/results/verdict.md",
+                cells[2],
+                cells[7].trim_matches('*'),
+                cells[5],
+                cells[6]
+            )
         });
     Training {
         command: format!(
