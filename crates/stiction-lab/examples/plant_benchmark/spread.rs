@@ -4,7 +4,7 @@
 //! calibration draws, the benchmark only checks it.
 
 use super::band::band_table;
-use super::confidence::confidence_table;
+use super::reliability::reliability_table;
 use super::tables::{by_class, goal_rows, GoalRow};
 use super::{judge, suite_title, Options};
 use rayon::prelude::*;
@@ -93,7 +93,7 @@ fn spread_table(o: &Options, suite: Suite, extra: u8, md: &mut String) {
     let _ = writeln!(md, "Pooled over the calibration draws:\n");
     let pooled_groups = by_class(&pooled_loops, &pooled_res);
     band_table(md, &pooled_groups);
-    confidence_table(md, &pooled_groups);
+    reliability_table(md, &pooled_groups);
 }
 
 /// The page: every suite asked for, on `extra` further draws.

@@ -1,10 +1,10 @@
-//! The plant benchmark's tables: verdicts, goals, index votes, reasons and sticky loops by band,
-//! per class of the catalogue.
+//! The plant benchmark's tables: verdicts and mean P, goals, index votes, reasons and sticky loops
+//! by band, per class of the catalogue.
 
 use super::VERDICTS;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use stiction_core::diagnose::{Diagnosis, Thresholds, Verdict, Vote};
+use stiction_core::diagnose::{Diagnosis, Finding, Verdict, Vote};
 use stiction_lab::catalogue::{BenchmarkLoop, LoopClass, NoiseLevel, Suite, Truth};
 
 /// The results by class, in the catalogue's class order.
@@ -31,96 +31,10 @@ pub(super) fn by_class<'a>(loops: &'a [BenchmarkLoop], res: &'a [(Diagnosis, f64
     m
 }
 
-/// With `--thorough`: the levels test's ratio per class (loops where it ran).
-pub(super) fn levels_table(md: &mut String, groups: &Groups) {
-    let levels_stiction = Thresholds::default().levels_stiction;
-    let _ = writeln!(
-        md,
-        "The levels test's ratio (loops where it ran; it votes stiction from {levels_stiction:.0}):\n"
-    );
-    let _ = writeln!(
-        md,
-        "| class | tested | median | 95th percentile | at or above the threshold |"
-    );
-    let _ = writeln!(md, "|---|---|---|---|---|");
-    for (class, of) in groups {
-        let mut r: Vec<f64> = of
-            .iter()
-            .filter_map(|(_, d)| {
-                d.families
-                    .iter()
-                    .find_map(|f| f.model.as_ref().and_then(|m| m.levels.as_ref()))
-                    .map(|l| l.ratio)
-            })
-            .collect();
-        r.sort_by(f64::total_cmp);
-        let at = |q: f64| {
-            r.get(((r.len() as f64 - 1.0) * q).round() as usize)
-                .copied()
-                .unwrap_or(f64::NAN)
-        };
-        let above = r.iter().filter(|&&x| x >= levels_stiction).count();
-        let _ = writeln!(
-            md,
-            "| {class} | {} of {} | {:.1} | {:.1} | {above} |",
-            r.len(),
-            of.len(),
-            at(0.5),
-            at(0.95)
-        );
-    }
-    let _ = writeln!(md);
-}
-
-/// With `--thorough`: the hidden-valve family per class (where it ran, its ratio, its votes).
-pub(super) fn hidden_valve_table(md: &mut String, groups: &Groups) {
-    let t = Thresholds::default();
-    let (threshold, draws) = (t.hidden_valve_threshold, t.hidden_valve_draws);
-    use stiction_core::diagnose::{Family, Vote};
-    let _ = writeln!(
-        md,
-        "The hidden-valve family (with `--thorough`; it runs where the other families have not decided `stiction`, on an oscillating \
-         loop with PV recorded and OP within 10 % of span, and votes stiction from a ratio of {threshold:.0}, the median of {draws} draws of \
-         the particle filter's noise where the first reaches it; the ratios below are the median where there were {draws}):\n"
-    );
-    let _ = writeln!(
-        md,
-        "| class | not run (already stiction) | gated out | judged | median ratio | highest | votes stiction |"
-    );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
-    for (class, of) in groups {
-        let fams: Vec<_> = of
-            .iter()
-            .filter_map(|(_, d)| d.families.iter().find(|f| f.family == Family::HiddenValve))
-            .collect();
-        let mut r: Vec<f64> = fams
-            .iter()
-            .filter_map(|f| f.hidden_valve.as_ref().map(|h| h.ratio))
-            .collect();
-        r.sort_by(f64::total_cmp);
-        let not_run = fams
-            .iter()
-            .filter(|f| f.note.starts_with("not run"))
-            .count();
-        let votes = fams.iter().filter(|f| f.vote == Vote::Stiction).count();
-        let median = r.get(r.len().saturating_sub(1) / 2).copied();
-        let fmt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
-        let _ = writeln!(
-            md,
-            "| {class} | {not_run} | {} | {} | {} | {} | {votes} |",
-            fams.len() - not_run - r.len(),
-            r.len(),
-            fmt(median),
-            fmt(r.last().copied()),
-        );
-    }
-    let _ = writeln!(md);
-}
-
 pub(super) fn verdict_table(md: &mut String, groups: &Groups) {
     let _ = writeln!(
         md,
-        "| class | truth | loops | stiction | no_stiction | undetermined | insufficient_data | right | mean confidence | slips (median) |"
+        "| class | truth | loops | stiction | no_stiction | undetermined | insufficient_data | right | mean P | slips (median) |"
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     for (class, items) in groups {
@@ -132,14 +46,18 @@ pub(super) fn verdict_table(md: &mut String, groups: &Groups) {
             Truth::NotSticky => pct(c[1], n),
             Truth::BacklashOnly => "(outside the goals)".into(),
         };
-        // the mean confidence of the decided verdicts
-        let decided: Vec<f64> = ds.iter().filter_map(|d| d.confidence).collect();
-        let conf = decided.iter().sum::<f64>() / decided.len().max(1) as f64;
+        // the mean probability of a sticky valve over the loops judged (those given one)
+        let judged: Vec<f64> = ds.iter().filter_map(|d| d.probability).collect();
+        let mean_p = if judged.is_empty() {
+            "-".to_string()
+        } else {
+            format!("{:.2}", judged.iter().sum::<f64>() / judged.len() as f64)
+        };
         let mut slips: Vec<usize> = items.iter().map(|i| i.0.slips).collect();
         slips.sort_unstable();
         let _ = writeln!(
             md,
-            "| {class} | {} | {n} | {} | {} | {} | {} | {right} | {conf:.2} | {} |",
+            "| {class} | {} | {n} | {} | {} | {} | {} | {right} | {mean_p} | {} |",
             class.truth().name(),
             c[0],
             c[1],
@@ -164,7 +82,8 @@ pub(super) struct GoalRow {
     pub met: bool,
 }
 
-/// The goals of a suite's issue (10 or 14), computed on the grouped results.
+/// The goals of a suite's issue (10, 14 or 69), computed on the grouped results. The plant
+/// windows' look-alikes are held to the routine windows' 90 %.
 pub(super) fn goal_rows(suite: Suite, groups: &Groups) -> Vec<GoalRow> {
     let of = |t: Truth| -> Vec<&Diagnosis> {
         groups
@@ -177,10 +96,17 @@ pub(super) fn goal_rows(suite: Suite, groups: &Groups) -> Vec<GoalRow> {
     let share = |n: usize, of: usize| n as f64 / of.max(1) as f64;
     let percent = |v: f64| format!("{:.1} %", 100.0 * v);
     let mut rows = Vec::new();
-    let look_alike_target = if suite == Suite::Routine { 0.90 } else { 0.95 };
-    if sticky.is_empty() || healthy.is_empty() && suite == Suite::Routine {
+    // issue 10's balanced accuracy on the routine windows, issue 69's (for real records) on the
+    // plant windows shaped after them; issue 14's share of sticky loops found on the fast loops
+    let balanced_target = match suite {
+        Suite::Routine => Some(0.95),
+        Suite::Plant => Some(0.90),
+        Suite::Fast => None,
+    };
+    let look_alike_target = if suite == Suite::Fast { 0.95 } else { 0.90 };
+    if sticky.is_empty() || healthy.is_empty() && balanced_target.is_some() {
         // one side only (--only): no balanced accuracy or sticky share to compute
-    } else if suite == Suite::Routine {
+    } else if let Some(target) = balanced_target {
         let tpr = share(count(&sticky, Verdict::Stiction), sticky.len());
         let tnr = share(count(&healthy, Verdict::NoStiction), healthy.len());
         let ba = (tpr + tnr) / 2.0;
@@ -190,8 +116,8 @@ pub(super) fn goal_rows(suite: Suite, groups: &Groups) -> Vec<GoalRow> {
             value: ba,
             share: false,
             shown: format!("{ba:.3} ({tpr:.3} / {tnr:.3})"),
-            target: ">= 0.95".into(),
-            met: ba >= 0.95,
+            target: format!(">= {target:.2}"),
+            met: ba >= target,
         });
     } else {
         let tpr = share(count(&sticky, Verdict::Stiction), sticky.len());
@@ -292,7 +218,7 @@ pub(super) fn vote_table(md: &mut String, groups: &Groups) {
     let _ = writeln!(md);
 }
 
-/// A reason with every number (digits, a decimal point, a sign) shown as one `#`.
+/// A text with every number (digits, a decimal point, a sign) shown as one `#`.
 fn blank_numbers(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut chars = text.chars().peekable();
@@ -314,20 +240,40 @@ fn blank_numbers(text: &str) -> String {
     out
 }
 
-/// The most frequent reasons given per class (numbers blanked so alike reasons group).
+/// A finding's kind as the JSON names it (`fit_gain`, `sticks`, ...); a data-quality gate's with
+/// its message, numbers blanked.
+pub(super) fn finding_kind(f: &Finding) -> String {
+    if let Finding::Record { message } = f {
+        return format!("record: {}", blank_numbers(message));
+    }
+    serde_json::to_value(f)
+        .ok()
+        .and_then(|v| v.get("kind")?.as_str().map(str::to_string))
+        .unwrap_or_else(|| "?".into())
+}
+
+/// The most frequent reasons given per class: the verdict and the kinds of the findings it names
+/// (`diagnose::Finding`), so alike reasons group.
 pub(super) fn reason_table(md: &mut String, groups: &Groups) {
     let _ = writeln!(
         md,
-        "Most frequent reasons (for verdicts that give one; numbers shown as #):\n"
+        "Most frequent reasons (the verdict and the findings it names, by kind; the two most frequent per class):\n"
     );
-    let _ = writeln!(md, "| class | reason | loops |\n|---|---|---|");
+    let _ = writeln!(md, "| class | verdict: findings | loops |\n|---|---|---|");
     for (class, items) in groups {
         let mut counts: BTreeMap<String, usize> = BTreeMap::new();
         for (_, d) in items {
-            if let Some(r) = &d.reason {
-                let key = blank_numbers(r);
-                *counts.entry(key).or_default() += 1;
-            }
+            let kinds: Vec<String> = d.reasons.iter().map(|r| finding_kind(&r.finding)).collect();
+            let key = format!(
+                "{}: {}",
+                d.verdict,
+                if kinds.is_empty() {
+                    "-".to_string()
+                } else {
+                    kinds.join(" + ")
+                }
+            );
+            *counts.entry(key).or_default() += 1;
         }
         let mut top: Vec<(String, usize)> = counts.into_iter().collect();
         top.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
@@ -341,7 +287,7 @@ pub(super) fn reason_table(md: &mut String, groups: &Groups) {
 /// Sticky loops called stiction, by band size and noise level.
 pub(super) fn sticky_table(md: &mut String, loops: &[BenchmarkLoop], res: &[(Diagnosis, f64)]) {
     let bins = [
-        (0.0, 1.0, "0.5-1 %"),
+        (0.0, 1.0, "under 1 %"),
         (1.0, 2.0, "1-2 %"),
         (2.0, 99.0, "2-5 %"),
     ];
