@@ -4,13 +4,14 @@
 //! first OP) is scored with the plain output-error test on levels (`stiction_lab::clean_fit`: a
 //! filter bank beside a piecewise-linear drift, which the controller's proportional kick cannot
 //! bias), and the best band's log-likelihood ratio against OP is held to the thresholds. Beside
-//! it: the same test with the recorded valve position (a ceiling), the model family's vote and
+//! it: the same test with the recorded valve position (a ceiling), the model family's vote (since
+//! issue 69 its statistics' share of the verdict model's log-odds, stiction from `diagnose::VOTE`) and
 //! `diagnose`'s verdict, and what the verdict would be with the walk's test added.
 //!
 //!     cargo run --release -p stiction-lab --example clean_walk -- [--suite routine|fast] [--benchmark] [--out FILE] [--jsonl FILE]
 //!
 //! `--jsonl FILE` also writes a line per loop with the walked ratio, the same walk whitened by an
-//! AR noise model (`identify::levels`, the levels test `diagnose --thorough` runs), the whitened
+//! AR noise model (`identify::levels`, the levels test `diagnose --thorough` ran before issue 69), the whitened
 //! walk held to 40 bands of a geometric grid only (`coarse`: a cheap walk loses most of what the
 //! exact one finds), the recorded valve's ratios and `diagnose`'s result.
 //!
@@ -65,7 +66,7 @@ fn judge(l: &BenchmarkLoop) -> Row {
     let clock = std::time::Instant::now();
     let fit = CleanFit::new(&d.pv, l.integrating, BANK);
     let with_op = fit.sse(&d.op);
-    // the same test whitened by an AR noise model (`identify::levels`, what `--thorough` runs)
+    // the same test whitened by an AR noise model (`identify::levels`, what `--thorough` ran)
     let white = LevelsFit::new(&d.pv, &d.op, l.integrating);
     let mut scratch = white.scratch();
     let white_op = white.sse(&d.op, &mut scratch);

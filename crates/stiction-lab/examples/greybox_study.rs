@@ -18,7 +18,7 @@
 //! the setpoint (`stiction_lab::setpoint`; crates/stiction-lab/journal/accuracy-history.md, "the process from the setpoint").
 //!
 //! The threshold is the 97.5th percentile of the not-sticky loops' statistic, historian-compressed
-//! PVs left out (`diagnose` recognises them and runs no levels test on them). Slow on purpose
+//! PVs left out (`diagnose` recognises them and reads no shape from them). Slow on purpose
 //! (about 0.3 s a loop): a study, not a method `diagnose` can afford as it stands.
 
 use stiction_lab::catalogue_loop;

@@ -4,7 +4,9 @@
 //! near the loop's period, aggressive tuning near the stability limit, OP saturating, a cascade's
 //! inner loop whose setpoint moves with the outer loop (setpoint not recorded). Every loop is
 //! judged by `diagnose` with the library defaults; the table counts the verdicts and the loop
-//! family's votes per class.
+//! family's votes per class (since issue 69 its lag's share of the verdict model's log-odds:
+//! stiction from `diagnose::VOTE`, undetermined where the family measured no lag; what a
+//! stiction vote rests on, `StictionBasis`, is still the family's own reading).
 //!
 //!     cargo run --release -p stiction-lab --example loop_benchmark -- \
 //!         [--per-class 40] [--out crates/stiction-lab/results/loop-benchmark.md] [--jsonl /tmp/loops.jsonl]
@@ -389,7 +391,7 @@ fn main() {
     );
     let _ = writeln!(
         md,
-        "\nA valve whose cycle is many times its band needs a loop near its stability limit: Kano's describing function with J = S \
+        "\n(Written for the loop family's own vote, before issue 69's calibrated verdict.) A valve whose cycle is many times its band needs a loop near its stability limit: Kano's describing function with J = S \
          (Stenman's valve when OP moves more than the band per sample) is 1.02 at a lag of 0.5 degrees for an OP amplitude of 5.75 bands \
          (the issue's 30-53 % with 2 %), so the balance holds only where the loop gain is 0.98 at -179.5 degrees: no identified margin \
          tells that loop from a linear one at its limit, and the family leaves it to the others. It votes where the valve must add a lag \

@@ -24,7 +24,7 @@ use stiction_lab::study_args;
 use clean_fit::CleanFit;
 use rayon::prelude::*;
 use std::fmt::Write as _;
-/// The filter bank: the levels test's (time constants 0.5-160 samples, delays 3 and 8).
+/// The filter bank: the former levels test's (time constants 0.5-160 samples, delays 3 and 8).
 use stiction_core::identify::levels::BANK;
 use stiction_core::identify::{self, Data, Structure};
 use stiction_core::models::Model;
