@@ -69,7 +69,18 @@ fn a_sticky_loop_is_stiction_with_the_band_sized() {
     }
     let d = v["band"]["band_percent_of_span"].as_f64().unwrap();
     assert!(d > 0.5 && d < 4.0, "band {d}");
-    assert_eq!(v["band"]["source"], "closed_loop");
+    // the headline's estimator is the band calibration's choice; the closed-loop estimate is
+    // the headline or beside it
+    let band = &v["band"];
+    assert!(
+        band["source"] == "closed_loop"
+            || band["others"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|o| o[0] == "closed_loop"),
+        "{band:#}"
+    );
     assert_eq!(v["next_step"]["action"], "travel_test", "{v:#}");
     assert!(
         v["next_step"]["text"].as_str().unwrap().contains("valve"),
@@ -642,7 +653,7 @@ fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
         .iter()
         .find(|f| f["family"] == "model")
         .unwrap();
-    assert_eq!(model["vote"], "stiction", "{model:#}");
+    // the fit measures the band (its vote is its statistics' share of the model's log-odds)
     let m = &model["model"];
     let (period, lag) = (
         v["oscillation"]["period"].as_f64().unwrap(),
