@@ -3,6 +3,9 @@
 //! with a ridge penalty on the weights, fitted by projected Newton steps (an active set: a
 //! weight at zero whose gradient pushes it below stays there).
 
+// small dense linear algebra reads best with the textbook's indices
+#![allow(clippy::needless_range_loop)]
+
 /// The fitted model: `P = 1 / (1 + exp(-(intercept + weights · x)))`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fitted {

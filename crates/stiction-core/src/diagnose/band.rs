@@ -112,11 +112,15 @@ pub(super) fn size(
     let scan = fits.map(|f| f.stenman.params[0]);
     let slip = fits.map(|f| f.slip_jump.params[0]).filter(|s| *s > 0.0);
     if band.is_none() {
+        // the first estimate that finds a band (a fit that settles at no band finds none)
+        let found = |b: &Band| b.op_units > 0.0;
         band = slip
             .map(|s| band_of(s, BandSource::SlipJumpFit, req))
-            .or(closed.clone())
-            .or(scan.map(|b| band_of(b, BandSource::FitScan, req)))
-            .or(beside.stick.map(|t| band_of(t, BandSource::StickSlip, req)));
+            .filter(found)
+            .or(closed.clone().filter(found))
+            .or(scan.map(|b| band_of(b, BandSource::FitScan, req)).filter(found))
+            .or(beside.stick.map(|t| band_of(t, BandSource::StickSlip, req)))
+            .or(beside.describing.map(|b| band_of(b, BandSource::DescribingFunction, req)));
     }
     let Some(mut band) = band else {
         return;

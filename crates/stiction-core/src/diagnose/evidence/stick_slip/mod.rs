@@ -92,6 +92,8 @@ pub(crate) fn controller_sign(op: &[f64], error: &[f64], setpoint_recorded: bool
 }
 
 /// The first `k` unknowns of `a x = b` (Gaussian elimination with partial pivoting).
+// small dense linear algebra reads best with the textbook's indices
+#[allow(clippy::needless_range_loop)]
 fn solve(mut a: [[f64; 3]; 3], mut b: [f64; 3], k: usize) -> Option<[f64; 3]> {
     for c in 0..k {
         let p = (c..k).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;

@@ -322,14 +322,14 @@ mod tests {
         let mut op = Vec::with_capacity(n);
         let mut pv = noise(n, 7);
         let sp = vec![1.0; n];
-        for i in 0..n {
+        for (i, v) in pv.iter_mut().enumerate() {
             let (o, p) = if i < 100 {
                 (50.0 + 0.02 * i as f64, 0.0)
             } else {
                 (52.0 - 0.01 * (i - 100) as f64, 1.5)
             };
             op.push(o);
-            pv[i] += p;
+            *v += p;
         }
         (op, pv, sp)
     }
