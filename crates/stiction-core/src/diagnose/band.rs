@@ -118,9 +118,13 @@ pub(super) fn size(
             .map(|s| band_of(s, BandSource::SlipJumpFit, req))
             .filter(found)
             .or(closed.clone().filter(found))
-            .or(scan.map(|b| band_of(b, BandSource::FitScan, req)).filter(found))
+            .or(scan
+                .map(|b| band_of(b, BandSource::FitScan, req))
+                .filter(found))
             .or(beside.stick.map(|t| band_of(t, BandSource::StickSlip, req)))
-            .or(beside.describing.map(|b| band_of(b, BandSource::DescribingFunction, req)));
+            .or(beside
+                .describing
+                .map(|b| band_of(b, BandSource::DescribingFunction, req)));
     }
     let Some(mut band) = band else {
         return;
