@@ -94,6 +94,11 @@ pub(super) fn size(
     req: &DiagnoseRequest,
 ) {
     let beside = Beside::new(d, sub, offset, osc, req.ts);
+    let op_noise = d
+        .families
+        .iter()
+        .find_map(|f| f.stick_slip.as_ref())
+        .map_or_else(|| crate::detect::held_noise(sub.op), |s| s.op_noise);
     let mut band = beside.valve.map(|(d, pct, interval)| Band {
         band_percent_of_span: pct,
         op_units: d,
@@ -112,8 +117,8 @@ pub(super) fn size(
     let scan = fits.map(|f| f.stenman.params[0]);
     let slip = fits.map(|f| f.slip_jump.params[0]).filter(|s| *s > 0.0);
     if band.is_none() {
-        // the first estimate that finds a band (a fit that settles at no band finds none)
-        let found = |b: &Band| b.op_units > 0.0;
+        // the first estimate that finds a band: one under OP's noise is none a fit resolves
+        let found = |b: &Band| b.op_units > op_noise;
         band = slip
             .map(|s| band_of(s, BandSource::SlipJumpFit, req))
             .filter(found)

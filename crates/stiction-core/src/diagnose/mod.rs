@@ -100,6 +100,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         op: r.op,
         pv: r.pv,
         sp: r.sp,
+        setpoint: sp,
         mv: r.mv,
         error,
         oscillation,

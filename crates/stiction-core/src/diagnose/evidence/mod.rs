@@ -149,6 +149,9 @@ pub struct Context<'a> {
     pub pv: &'a [f64],
     /// SP over the analysed stretch, when recorded.
     pub sp: Option<&'a [f64]>,
+    /// The setpoint the control error is taken from: SP when recorded, else the setpoint read
+    /// off the record ([`crate::diagnose::setpoint`]), if any.
+    pub setpoint: Option<&'a [f64]>,
     /// The recorded valve position (mv) over the analysed stretch, OP units, when recorded.
     pub mv: Option<&'a [f64]>,
     /// The control error (SP - PV; without SP, PV's deviation from the setpoint read off the

@@ -89,19 +89,9 @@ pub(crate) fn unresolved_cycle(osc: &super::Oscillation, ts: f64) -> Option<(f64
         })
 }
 
-/// The families whose statistics the model reads, and which.
-fn family_of(s: Statistic) -> Family {
-    match s {
-        Statistic::StickShare | Statistic::Sticks | Statistic::Stuck => Family::StickSlip,
-        Statistic::FitGain | Statistic::FitBand | Statistic::FitTest => Family::Model,
-        Statistic::CycleShape => Family::Shape,
-        Statistic::LoopLag => Family::Loop,
-    }
-}
-
 /// Each family's vote and strength from its statistics' share of the log-odds (the valve family
 /// keeps its own: it decides; the hidden valve's is its own, read by no one).
-fn set_votes(families: &mut [FamilyEvidence], reading: &Reading) {
+fn set_votes(families: &mut [FamilyEvidence], reading: &Reading, read: &[Statistic]) {
     for f in families.iter_mut() {
         if matches!(f.family, Family::Valve | Family::HiddenValve) {
             continue;
@@ -109,7 +99,8 @@ fn set_votes(families: &mut [FamilyEvidence], reading: &Reading) {
         let parts: Vec<&Contribution> = reading
             .contributions
             .iter()
-            .filter(|c| family_of(c.statistic) == f.family && c.value.is_some())
+            .filter(|c| c.statistic.family() == f.family && c.value.is_some())
+            .filter(|c| read.contains(&c.statistic))
             .collect();
         if parts.is_empty() {
             (f.vote, f.strength, f.contribution) = (Vote::Undetermined, 0.0, None);
@@ -134,7 +125,8 @@ pub(super) fn decide(
 ) -> Decision {
     let model = VerdictModel::embedded();
     let reading = model.read(|s| measured.get(s));
-    set_votes(families, &reading);
+    let read: Vec<Statistic> = model.inputs.iter().map(|i| i.statistic).collect();
+    set_votes(families, &reading, &read);
     let p = reading.probability;
     let valve = families
         .iter()

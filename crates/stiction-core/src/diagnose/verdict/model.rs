@@ -38,6 +38,17 @@ pub enum Statistic {
 }
 
 impl Statistic {
+    /// The family that measures it.
+    pub fn family(self) -> crate::diagnose::Family {
+        use crate::diagnose::Family;
+        match self {
+            Statistic::StickShare | Statistic::Sticks | Statistic::Stuck => Family::StickSlip,
+            Statistic::FitGain | Statistic::FitBand | Statistic::FitTest => Family::Model,
+            Statistic::CycleShape => Family::Shape,
+            Statistic::LoopLag => Family::Loop,
+        }
+    }
+
     /// Every statistic, in the model file's order.
     pub const ALL: [Statistic; 8] = [
         Statistic::StickShare,

@@ -125,12 +125,13 @@ impl EvidenceFamily for StickSlip {
 
     fn evaluate(&self, ctx: &Context) -> FamilyEvidence {
         let settings = &ctx.req.settings;
-        let sign = controller_sign(ctx.op, &ctx.error, ctx.sp.is_some());
+        let sign = controller_sign(ctx.op, &ctx.error, ctx.setpoint.is_some());
         let signals = steps::Signals {
             op: ctx.op,
             pv: ctx.pv,
             error: &ctx.error,
-            sp: ctx.sp,
+            // a setpoint step, recorded or read off the record, moves PV through a healthy valve
+            sp: ctx.setpoint,
             sign,
             pv_noise: ctx.pv_noise,
             op_noise: ctx.op_noise,
