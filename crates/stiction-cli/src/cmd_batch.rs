@@ -134,7 +134,7 @@ fn settings(a: &Args) -> Value {
     let c = &a.columns;
     serde_json::json!({
         "op": c.op, "pv": c.pv, "sp": c.sp, "mode": c.mode, "time": c.time, "ts": c.ts,
-        "integrating": c.integrating, "quantify": !a.no_quantify, "loop_id": a.loop_id,
+        "integrating": c.integrating, "self_regulating": c.self_regulating, "quantify": !a.no_quantify, "loop_id": a.loop_id,
         "estimate_start": c.estimate_start, "tags": a.tags,
     })
 }

@@ -96,9 +96,14 @@ pub struct Columns {
     /// Sampling time in seconds [default: the median step of the time column, else 1]
     #[arg(long)]
     pub ts: Option<f64>,
-    /// The process is integrating (a level loop): the indices use their integrating variants
-    #[arg(long)]
+    /// The process is integrating (a level loop): the indices and the fits use their integrating
+    /// variants [default: a column named by a tag (LIC..., FIC...) hints it, else the record's
+    /// behaviour decides]
+    #[arg(long, conflicts_with = "self_regulating")]
     pub integrating: bool,
+    /// The process is self-regulating (not a level), whatever its tag or behaviour suggest
+    #[arg(long)]
+    pub self_regulating: bool,
     /// Closed-loop estimate: estimate where the valve stood at the first sample (as quantify
     /// --estimate-start; about 3-4x the estimate's time)
     #[arg(long)]
@@ -265,10 +270,29 @@ impl Columns {
         }
     }
 
+    /// The loop's kind as the flags say, else as a column's ISA-5.1 tag hints (PV's name first,
+    /// then OP's), with the tag; `None` lets the record's behaviour decide.
+    pub fn kind(&self) -> (Option<bool>, Option<String>) {
+        if self.integrating {
+            return (Some(true), None);
+        }
+        if self.self_regulating {
+            return (Some(false), None);
+        }
+        [&self.pv, &self.op]
+            .into_iter()
+            .find_map(|name| stiction_core::diagnose::loop_kind::hinted_by_tag(name))
+            .map_or((None, None), |(integrating, tag)| {
+                (Some(integrating), Some(tag))
+            })
+    }
+
     pub fn request(&self, ts: f64) -> DiagnoseRequest {
+        let (integrating, integrating_tag) = self.kind();
         DiagnoseRequest {
             ts,
-            integrating: self.integrating,
+            integrating,
+            integrating_tag,
             estimate_start: self.estimate_start,
             thorough: self.thorough,
             op_range: self.op_range.unwrap_or([0.0, 100.0]),

@@ -231,7 +231,7 @@ fn main() {
             let label = &labels[name];
             let req = DiagnoseRequest {
                 ts: label[idx("Ts")].parse().unwrap_or(1.0),
-                integrating: label[idx("integrating")] == "True",
+                integrating: (label[idx("integrating")] == "True").then_some(true),
                 quantify: with_quantify,
                 thorough,
                 ..DiagnoseRequest::default()

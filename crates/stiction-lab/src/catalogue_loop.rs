@@ -1,6 +1,6 @@
 //! A catalogue loop ([`crate::catalogue`]) as `stiction diagnose loop.csv --sp sp`
-//! reads it: the setpoint and the time column given, `integrating` from the loop, the default
-//! request otherwise.
+//! reads it: the setpoint and the time column given, the default request otherwise (the loop's
+//! kind read off the record, as for a CSV whose columns name no tag).
 
 use crate::catalogue::BenchmarkLoop;
 use stiction_core::diagnose::{DiagnoseRequest, LoopRecord};
@@ -22,7 +22,6 @@ pub fn record(l: &BenchmarkLoop) -> LoopRecord<'_> {
 pub fn request(l: &BenchmarkLoop) -> DiagnoseRequest {
     DiagnoseRequest {
         ts: l.ts(),
-        integrating: l.integrating,
         ..DiagnoseRequest::default()
     }
 }

@@ -11,7 +11,11 @@ use stiction_core::record::{self, PrepareError, Prepared, Signals};
 #[derive(Clone, Debug)]
 pub struct Settings {
     pub ts: Option<f64>,
-    pub integrating: bool,
+    /// The loop's kind as the caller says (`None`: a tag in `tags` hints it, else the record's
+    /// behaviour decides).
+    pub integrating: Option<bool>,
+    /// The names of PV's and OP's columns, read for an ISA-5.1 tag (the CLI reads its columns').
+    pub tags: Vec<String>,
     pub window: Option<usize>,
     pub quantify: bool,
     pub op_range: [f64; 2],
@@ -25,9 +29,18 @@ pub struct Settings {
 impl Settings {
     /// The core's request, as the CLI's `Columns::request` builds it.
     pub fn request(&self, ts: f64) -> DiagnoseRequest {
+        let (integrating, integrating_tag) = match self.integrating {
+            Some(i) => (Some(i), None),
+            None => self
+                .tags
+                .iter()
+                .find_map(|t| core::loop_kind::hinted_by_tag(t))
+                .map_or((None, None), |(i, tag)| (Some(i), Some(tag))),
+        };
         DiagnoseRequest {
             ts,
-            integrating: self.integrating,
+            integrating,
+            integrating_tag,
             estimate_start: self.estimate_start,
             thorough: self.thorough,
             op_range: self.op_range,
@@ -83,8 +96,9 @@ pub fn run<'a>(signals: Signals<'a>, s: &Settings) -> Result<(Diagnosis, Prepare
 /// Diagnose one loop: the `Diagnosis` as JSON (the CLI's `diagnose --json`) and the notes of
 /// the record's preparation (rows sorted, repeated times dropped).
 #[pyfunction]
-#[pyo3(signature = (op, pv, sp=None, mv=None, auto=None, time=None, ts=None, integrating=false,
-    window=None, quantify=true, op_range=(0.0, 100.0), estimate_start=false, thorough=false, time_name=None))]
+#[pyo3(signature = (op, pv, sp=None, mv=None, auto=None, time=None, ts=None, integrating=None,
+    window=None, quantify=true, op_range=(0.0, 100.0), estimate_start=false, thorough=false, time_name=None,
+    tags=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose(
     py: Python<'_>,
@@ -95,17 +109,19 @@ pub fn diagnose(
     auto: Option<PyReadonlyArray1<'_, bool>>,
     time: Option<PyReadonlyArray1<'_, f64>>,
     ts: Option<f64>,
-    integrating: bool,
+    integrating: Option<bool>,
     window: Option<usize>,
     quantify: bool,
     op_range: (f64, f64),
     estimate_start: bool,
     thorough: bool,
     time_name: Option<String>,
+    tags: Option<Vec<String>>,
 ) -> PyResult<(String, Vec<String>)> {
     let settings = Settings {
         ts,
         integrating,
+        tags: tags.unwrap_or_default(),
         window,
         quantify,
         op_range: [op_range.0, op_range.1],

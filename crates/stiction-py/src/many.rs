@@ -93,8 +93,8 @@ fn row(fleet: &Fleet, id: &str, source: &str, (a, b): (usize, usize), s: &Settin
 /// end could not read, with the reason (a `failed` row each).
 #[pyfunction]
 #[pyo3(signature = (ids, sources, starts, op, pv, sp=None, mv=None, auto=None, time=None,
-    ts=None, integrating=false, quantify=true, op_range=(0.0, 100.0), estimate_start=false, thorough=false,
-    time_name=None, threads=None, progress=false, failed=None))]
+    ts=None, integrating=None, quantify=true, op_range=(0.0, 100.0), estimate_start=false, thorough=false,
+    time_name=None, threads=None, progress=false, failed=None, tags=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn diagnose_many(
     py: Python<'_>,
@@ -108,7 +108,7 @@ pub fn diagnose_many(
     auto: Option<PyReadonlyArray1<'_, bool>>,
     time: Option<PyReadonlyArray1<'_, f64>>,
     ts: Option<f64>,
-    integrating: bool,
+    integrating: Option<bool>,
     quantify: bool,
     op_range: (f64, f64),
     estimate_start: bool,
@@ -117,6 +117,7 @@ pub fn diagnose_many(
     threads: Option<usize>,
     progress: bool,
     failed: Option<HashMap<usize, String>>,
+    tags: Option<Vec<String>>,
 ) -> PyResult<String> {
     let failed = failed.unwrap_or_default();
     let fleet = Fleet {
@@ -140,6 +141,7 @@ pub fn diagnose_many(
     let settings = Settings {
         ts,
         integrating,
+        tags: tags.unwrap_or_default(),
         window: None,
         quantify,
         op_range: [op_range.0, op_range.1],

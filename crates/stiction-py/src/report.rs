@@ -61,7 +61,7 @@ fn page(
 /// `loop_id` names the loop in the title; `columns` (op, pv, sp, mode, time) the columns in the
 /// header, when the signals came from named columns.
 #[pyfunction]
-#[pyo3(signature = (op, pv, sp=None, mv=None, auto=None, time=None, ts=None, integrating=false,
+#[pyo3(signature = (op, pv, sp=None, mv=None, auto=None, time=None, ts=None, integrating=None,
     window=None, quantify=true, op_range=(0.0, 100.0), estimate_start=false, thorough=false, time_name=None,
     loop_id="loop".to_string(), columns=None))]
 #[allow(clippy::too_many_arguments)]
@@ -74,7 +74,7 @@ pub fn report(
     auto: Option<PyReadonlyArray1<'_, bool>>,
     time: Option<PyReadonlyArray1<'_, f64>>,
     ts: Option<f64>,
-    integrating: bool,
+    integrating: Option<bool>,
     window: Option<usize>,
     quantify: bool,
     op_range: (f64, f64),
@@ -84,9 +84,19 @@ pub fn report(
     loop_id: String,
     columns: Option<HashMap<String, String>>,
 ) -> PyResult<String> {
+    let tags: Vec<String> = columns
+        .as_ref()
+        .map(|c| {
+            ["pv", "op"]
+                .iter()
+                .filter_map(|k| c.get(*k).cloned())
+                .collect()
+        })
+        .unwrap_or_default();
     let settings = Settings {
         ts,
         integrating,
+        tags,
         window,
         quantify,
         op_range: [op_range.0, op_range.1],
@@ -95,7 +105,7 @@ pub fn report(
         time_name: time_name.unwrap_or_else(|| "time".into()),
     };
     let names = columns
-        .map(|c| column_names(&c, integrating))
+        .map(|c| column_names(&c, integrating == Some(true)))
         .transpose()
         .map_err(bad)?;
     let signals = Signals {

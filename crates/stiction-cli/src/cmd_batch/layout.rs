@@ -181,13 +181,16 @@ fn entry(at: String, e: RawEntry, folder: &Path, flags: &Columns) -> Result<Entr
     };
     let op = need(e.op, "op")?;
     let pv = need(e.pv, "pv")?;
-    let integrating = match e.integrating {
-        None => flags.integrating,
-        Some(Flag::Bool(b)) => b,
+    // a loop's integrating true or false says its kind; left out, the flags' (or its tag or
+    // behaviour) decide
+    let said = (flags.integrating, flags.self_regulating);
+    let (integrating, self_regulating) = match e.integrating {
+        None => said,
+        Some(Flag::Bool(b)) => (b, !b),
         Some(Flag::Text(t)) => match t.trim().to_ascii_lowercase().as_str() {
-            "" => flags.integrating,
-            "true" | "yes" | "1" | "y" => true,
-            "false" | "no" | "0" | "n" => false,
+            "" => said,
+            "true" | "yes" | "1" | "y" => (true, false),
+            "false" | "no" | "0" | "n" => (false, true),
             _ => bail!("{at}: loop '{id}': integrating is '{t}'; write true or false"),
         },
     };
@@ -214,6 +217,7 @@ fn entry(at: String, e: RawEntry, folder: &Path, flags: &Columns) -> Result<Entr
                 time: blank(e.time).or_else(|| flags.time.clone()),
                 ts,
                 integrating,
+                self_regulating,
                 estimate_start: flags.estimate_start,
                 thorough: flags.thorough,
                 mv: blank(e.mv),

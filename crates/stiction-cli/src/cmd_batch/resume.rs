@@ -23,6 +23,9 @@ pub struct LoopSettings {
     pub time: Option<String>,
     pub ts: Option<f64>,
     pub integrating: bool,
+    /// `--self-regulating`.
+    #[serde(default)]
+    pub self_regulating: bool,
     pub estimate_start: bool,
     /// The hidden-valve family (`--thorough`).
     #[serde(default)]
@@ -42,6 +45,7 @@ impl LoopSettings {
             time: c.time.clone(),
             ts: c.ts,
             integrating: c.integrating,
+            self_regulating: c.self_regulating,
             estimate_start: c.estimate_start,
             thorough: c.thorough,
             quantify,
@@ -173,6 +177,7 @@ mod tests {
             time: None,
             ts: Some(1.0),
             integrating: false,
+            self_regulating: false,
             estimate_start: false,
             thorough: false,
             mv: Some("mv".into()),

@@ -639,21 +639,36 @@ fn integrating_loop(dir: &Path, d: &str) -> String {
 }
 
 #[test]
-fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
+fn a_level_is_checked_and_its_band_measured_without_being_told_it_integrates() {
     // its cycle lasts about as long as the changes the closed-loop fit compares: differenced over
-    // a whole period, the cycle (and the valve that drives it) cancelled, and the fit with
-    // stiction did worse than the linear loop (`no_stiction`, while `quantify` found d = 2.0)
+    // a whole period, the cycle (and the valve that drives it) would cancel; the lag is kept off
+    // it and the fit measures the band. The loop is judged self-regulating unless told (or a tag
+    // says so), and the warning says PV behaves as a level's
     let dir = tempfile::tempdir().unwrap();
-    let judge = |f: &str| json(&ok(&["diagnose", f, "--sp", "sp", "--json"]));
-    let v = judge(&integrating_loop(dir.path(), "2"));
-    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    let judge = |f: &str, more: &[&str]| {
+        let mut args = vec!["diagnose", f, "--sp", "sp", "--json"];
+        args.extend_from_slice(more);
+        json(&ok(&args))
+    };
+    let sticky = integrating_loop(dir.path(), "2");
+    let v = judge(&sticky, &[]);
+    assert_eq!(v["loop_kind"]["integrating"], false, "{v:#}");
+    assert_eq!(v["loop_kind"]["behaves_integrating"], true, "{v:#}");
+    let warned = v["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|w| w.as_str().unwrap().contains("say --integrating"));
+    assert!(warned, "{:#}", v["warnings"]);
+    let v = judge(&sticky, &["--integrating"]);
+    assert_eq!(v["loop_kind"]["integrating"], true, "{v:#}");
+    assert_eq!(v["loop_kind"]["from"], "request", "{v:#}");
     let model = v["families"]
         .as_array()
         .unwrap()
         .iter()
         .find(|f| f["family"] == "model")
         .unwrap();
-    // the fit measures the band (its vote is its statistics' share of the model's log-odds)
     let m = &model["model"];
     let (period, lag) = (
         v["oscillation"]["period"].as_f64().unwrap(),
@@ -669,8 +684,35 @@ fn a_sticky_integrating_loop_is_stiction_without_being_told_it_integrates() {
         "{m:#}"
     );
     // the same loop with a healthy valve
-    let v = judge(&integrating_loop(dir.path(), "0"));
+    let v = judge(&integrating_loop(dir.path(), "0"), &[]);
     assert_ne!(v["verdict"], "stiction", "{v:#}");
+}
+
+#[test]
+fn a_tag_in_a_column_name_hints_the_loops_kind() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = integrating_loop(dir.path(), "2");
+    let text = std::fs::read_to_string(&f).unwrap();
+    let tagged = dir.path().join("tagged.csv");
+    std::fs::write(&tagged, text.replacen("pv", "LIC101.PV", 1)).unwrap();
+    let t = tagged.to_str().unwrap();
+    let v = json(&ok(&["diagnose", t, "--pv", "LIC101.PV", "--sp", "sp", "--json"]));
+    assert_eq!(v["loop_kind"]["integrating"], true, "{v:#}");
+    assert_eq!(v["loop_kind"]["from"], "tag", "{v:#}");
+    assert_eq!(v["loop_kind"]["tag"], "LIC101", "{v:#}");
+    // the flag overrides the tag
+    let v = json(&ok(&[
+        "diagnose",
+        t,
+        "--pv",
+        "LIC101.PV",
+        "--sp",
+        "sp",
+        "--self-regulating",
+        "--json",
+    ]));
+    assert_eq!(v["loop_kind"]["integrating"], false, "{v:#}");
+    assert_eq!(v["loop_kind"]["from"], "request", "{v:#}");
 }
 
 /// The same valve and noise with another seed: the cycle's period wanders, and read plainly the

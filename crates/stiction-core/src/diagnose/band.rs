@@ -1,13 +1,12 @@
 //! Sizing the band of a `stiction` verdict, in % of valve span. The band reported first is the
 //! estimator that the lab's calibration on simulated valves with known bands shows to be right
 //! (`band_calibration`, crates/stiction-lab/results/band-calibration.md): the recorded valve
-//! position's when there is one, else the closed-loop fit's slip-jump band (Kano's S, its jump
-//! free), else the closed-loop estimate (`quantify`, Stenman exact), else the fit's scan. Every
-//! other estimate is given beside it as what it is: the closed-loop estimate (with its interval of
-//! equally good bands in `Diagnosis::quantification`), the fit's scan, the OP travel per stick,
-//! the band whose describing function closes the loop's harmonic balance, the width of the
-//! oscillation's PV-OP ellipse (an apparent stiction that the tuning inflates, not the band); no
-//! rule replaces the first by another.
+//! position's when there is one, else the largest of the three closed-loop estimates (the fit's
+//! slip-jump band, Kano's S with its jump free; the closed-loop estimate, `quantify`'s Stenman
+//! exact, with its interval; the fit's scan): each errs low far more often than high. Every other
+//! estimate is given beside it as what it is: the other closed-loop estimates, the OP travel per
+//! stick, the band whose describing function closes the loop's harmonic balance, the width of the
+//! oscillation's PV-OP ellipse (an apparent stiction that the tuning inflates, not the band).
 
 use super::evidence::limit_cycle::StictionBasis;
 use super::evidence::Family;
@@ -117,19 +116,21 @@ pub(super) fn size(
     let scan = fits.map(|f| f.stenman.params[0]);
     let slip = fits.map(|f| f.slip_jump.params[0]).filter(|s| *s > 0.0);
     if band.is_none() {
-        // the first estimate that finds a band: one under OP's noise is none a fit resolves
-        let found = |b: &Band| b.op_units > op_noise;
-        band = slip
-            .map(|s| band_of(s, BandSource::SlipJumpFit, req))
-            .filter(found)
-            .or(closed.clone().filter(found))
-            .or(scan
-                .map(|b| band_of(b, BandSource::FitScan, req))
-                .filter(found))
-            .or(beside.stick.map(|t| band_of(t, BandSource::StickSlip, req)))
-            .or(beside
-                .describing
-                .map(|b| band_of(b, BandSource::DescribingFunction, req)));
+        // the largest of the closed-loop estimates: each errs low far more often than high (a
+        // fit settles on a small band near OP), so the largest is nearest the simulated band
+        band = [
+            slip.map(|s| band_of(s, BandSource::SlipJumpFit, req)),
+            closed.clone(),
+            scan.map(|b| band_of(b, BandSource::FitScan, req)),
+        ]
+        .into_iter()
+        .flatten()
+        .filter(|b| b.op_units > op_noise)
+        .max_by(|a, b| a.op_units.total_cmp(&b.op_units))
+        .or(beside.stick.map(|t| band_of(t, BandSource::StickSlip, req)))
+        .or(beside
+            .describing
+            .map(|b| band_of(b, BandSource::DescribingFunction, req)));
     }
     let Some(mut band) = band else {
         return;
@@ -160,7 +161,11 @@ fn closed_loop_band(
     q.ts = req.ts;
     q.max_delay = req.max_delay;
     q.estimate_start = req.estimate_start;
-    q.integrating = Some(req.integrating);
+    q.integrating = d
+        .loop_kind
+        .as_ref()
+        .map(|k| k.integrating)
+        .or(req.integrating);
     let qr = match quantify(sub.op, sub.pv, &q) {
         Ok(qr) => qr,
         Err(err) => {

@@ -20,6 +20,7 @@ mod band;
 mod bridge;
 pub mod evidence;
 mod gates;
+pub mod loop_kind;
 pub mod oscillation;
 pub mod reach;
 pub mod reasons;
@@ -65,6 +66,8 @@ struct Judged {
     fits: Option<crate::quantify::FitComparison>,
     /// Without a recorded setpoint, the setpoint read off OP and PV ([`setpoint`]).
     setpoint: Option<setpoint::Inferred>,
+    /// The loop's kind and where it was read.
+    kind: loop_kind::LoopKind,
 }
 
 /// The warning on a record without SP begins so.
@@ -91,16 +94,26 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
     let compare = CompareRequest {
         ts: req.ts,
         max_delay: req.max_delay,
-        integrating: Some(req.integrating),
+        integrating: Some(req.integrating.unwrap_or(false)),
         lag: None,
     };
     let (fits, lag_bound) = evidence::model::compared(r.op, r.pv, &compare);
+    let kind = loop_kind::LoopKind {
+        integrating: req.integrating.unwrap_or(false),
+        source: match (&req.integrating, &req.integrating_tag) {
+            (Some(_), Some(tag)) => loop_kind::KindSource::Tag { tag: tag.clone() },
+            (Some(_), None) => loop_kind::KindSource::Request,
+            (None, _) => loop_kind::KindSource::Default,
+        },
+        behaves_integrating: loop_kind::behaves_integrating(r.op, r.pv, req.max_delay),
+    };
     let ctx = Context {
         req,
         op: r.op,
         pv: r.pv,
         sp: r.sp,
         setpoint: sp,
+        integrating: kind.integrating,
         mv: r.mv,
         error,
         oscillation,
@@ -142,6 +155,7 @@ fn judge(r: &LoopRecord, req: &DiagnoseRequest) -> Judged {
         decision,
         fits,
         setpoint: inferred,
+        kind,
     }
 }
 
@@ -236,6 +250,7 @@ pub fn diagnose_checked(
         quantified: None,
         windows,
         setpoint_read_off: None,
+        loop_kind: None,
         warnings,
         seconds: 0.0,
     };
@@ -259,6 +274,10 @@ pub fn diagnose_checked(
     d.reasons = j.decision.reasons;
     d.next_step = j.decision.next_step;
     d.statistics = j.decision.reading;
+    if let Some(w) = kind_words(&j.kind) {
+        d.warnings.push(w);
+    }
+    d.loop_kind = Some(j.kind);
     d.families = j.families;
     d.indices = j.indices;
     d.reach = reach::of(&d, sub.op, req);
@@ -278,6 +297,32 @@ fn unjudged(mut d: Diagnosis, reason: String, action: Action, started: Instant) 
     d.next_step = NextStep::plain(action);
     d.seconds = started.elapsed().as_secs_f64();
     d
+}
+
+/// What the diagnosis assumed of the loop's kind, where a user should know: a tag's hint, or a
+/// record that behaves otherwise than the loop is judged.
+fn kind_words(k: &loop_kind::LoopKind) -> Option<String> {
+    let (kind, flag) = if k.integrating {
+        ("an integrating process (a level)", "--self-regulating")
+    } else {
+        ("a self-regulating process", "--integrating")
+    };
+    if let loop_kind::KindSource::Tag { tag } = &k.source {
+        return Some(format!(
+            "judged as {kind} from the tag {tag} in a column's name ({flag} says otherwise)"
+        ));
+    }
+    match k.behaves_integrating {
+        Some(true) if !k.integrating => Some(
+            "judged as a self-regulating process, but PV's levels follow OP's integral better than OP, as a level's do: if the loop is a level, say --integrating"
+                .into(),
+        ),
+        Some(false) if k.integrating && k.source == loop_kind::KindSource::Request => Some(
+            "judged as an integrating process as asked, but PV's levels follow OP better than its integral, as a self-regulating process's do"
+                .into(),
+        ),
+        _ => None,
+    }
 }
 
 /// Why a record too short to judge is so.

@@ -9,8 +9,14 @@ use serde::{Deserialize, Serialize};
 pub struct DiagnoseRequest {
     /// Sampling time, seconds.
     pub ts: f64,
-    /// A level-type (integrating) process: the indices and the fits use their integrating variants.
-    pub integrating: bool,
+    /// The loop's kind: `Some(true)` an integrating process (a level: the indices and the fits
+    /// use their integrating variants), `Some(false)` a self-regulating one, `None` the record's
+    /// behaviour decides ([`super::loop_kind`]).
+    #[serde(default)]
+    pub integrating: Option<bool>,
+    /// The ISA-5.1 tag that set `integrating`, when a column's name did (said in a warning).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub integrating_tag: Option<String>,
     /// The data-quality gates' limits.
     pub limits: Limits,
     /// Fewest oscillation periods for the shape indices to judge an oscillation.
@@ -53,7 +59,8 @@ impl Default for DiagnoseRequest {
     fn default() -> Self {
         Self {
             ts: 1.0,
-            integrating: false,
+            integrating: None,
+            integrating_tag: None,
             limits: Limits::default(),
             min_periods: 4.0,
             min_samples: 200,

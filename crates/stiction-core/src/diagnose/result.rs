@@ -303,6 +303,9 @@ pub struct Diagnosis {
     /// (`diagnose::setpoint`): where it stepped and the levels between.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub setpoint_read_off: Option<SetpointReadOff>,
+    /// The loop's kind (integrating or self-regulating) and where it was read.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loop_kind: Option<super::loop_kind::LoopKind>,
     /// What the diagnosis had to assume (e.g. no setpoint recorded).
     pub warnings: Vec<String>,
     /// Time the diagnosis took, seconds.

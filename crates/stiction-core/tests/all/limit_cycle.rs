@@ -53,8 +53,9 @@ fn a_fast_sticky_loops_limit_cycle_needs_the_valves_lag_and_its_describing_funct
     let d = judge(&fast_loop(2.0, 1.3, None));
     let period = d.oscillation.as_ref().and_then(|o| o.period).unwrap();
     assert!((90.0..150.0).contains(&period), "period {period}");
+    // the loop family measures the lag the linear loop needs (the verdict's model does not read
+    // it: on the real records it calls a healthy level loop sticky)
     let f = loop_family(&d);
-    assert_eq!(f.vote, Vote::Stiction, "{}", f.note);
     let e = f.limit_cycle.as_ref().unwrap();
     assert!(e.margins.gain_margin.unwrap() > 1.0, "{e:?}");
     assert!((25.0..90.0).contains(&e.needed_lag_degrees), "{e:?}");
@@ -71,11 +72,10 @@ fn a_fast_sticky_loops_limit_cycle_needs_the_valves_lag_and_its_describing_funct
     // is within about a third of the observed one here
     let predicted = df.predicted_period.unwrap();
     assert!((predicted / period - 1.0).abs() < 0.4, "{df:?}");
-    // the lag the loop needs moves the verdict's model towards a sticky valve; on its own, here,
-    // not past its threshold (a regular cycle gives no sticks and fits alike with and without a
-    // band)
-    assert!(f.contribution.is_some_and(|c| c > 0.0), "{f:?}");
-    assert_ne!(d.verdict, Verdict::NoStiction, "{:?}", d.reasons);
+    // (the verdict: a near-sinusoidal limit cycle gives no sticks, a shape near a sine's and fits
+    // alike with and without a band; the verdict's model reads none of this family's figures, so
+    // such a valve can go unfound: the lab's verdict tables show the trade)
+    assert!(d.verdict != Verdict::InsufficientData, "{:?}", d.reasons);
 }
 
 #[test]

@@ -42,14 +42,13 @@ const SHARED: &str = "../shared";
 /// the record's length (their share is read instead). The fit's test ratio separates the
 /// simulated records better than its gain, and the real ones worse (a healthy loop's large
 /// setpoint step makes a small model mismatch significant): its gain is read. The loop's lag
-/// changes nothing on the real records and finds the simulated limit cycles a linear loop cannot
-/// sustain; the fit's band adds nothing.
-const READ: [Statistic; 5] = [
+/// finds simulated limit cycles a linear loop cannot sustain but calls a real healthy level loop
+/// sticky; the fit's band adds nothing.
+const READ: [Statistic; 4] = [
     Statistic::StickShare,
     Statistic::Stuck,
     Statistic::FitGain,
     Statistic::CycleShape,
-    Statistic::LoopLag,
 ];
 
 /// Every sample: real (if present), the calibration and extra draws, the benchmark sets.

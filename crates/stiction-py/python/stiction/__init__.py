@@ -54,7 +54,7 @@ def diagnose(
     mode: Any = None,
     mv: Any = None,
     ts: Optional[float] = None,
-    integrating: bool = False,
+    integrating: Optional[bool] = None,
     window: Optional[int] = None,
     quantify: bool = True,
     *,
@@ -74,7 +74,9 @@ def diagnose(
     mode: controller mode (auto/manual, 1/0, bools): only automatic stretches are judged.
     mv: the recorded valve position, when there is one (direct evidence).
     ts: sampling time in seconds (default: the median step of the time, else 1).
-    integrating: a level loop (the indices use their integrating variants).
+    integrating: True a level loop (the indices and fits use their integrating variants), False
+        self-regulating, None (default): a column named by an ISA-5.1 tag (LIC..., FIC...) hints
+        it, else the record's behaviour decides.
     window: also a verdict per window of this many samples (``Diagnosis.windows``).
     quantify: size the band with the closed-loop estimate when the verdict is stiction.
     op_range: OP of a closed and a fully open valve; the band is in % of this span.
@@ -92,7 +94,7 @@ def diagnose(
         cols["op"], cols["pv"], sp=cols["sp"], mv=cols["mv"], auto=cols["auto"], time=cols["time"],
         ts=ts, integrating=integrating, window=window, quantify=quantify,
         op_range=tuple(op_range), estimate_start=estimate_start, thorough=thorough,
-        time_name=time_name,
+        time_name=time_name, tags=[c for c in (pv, op) if isinstance(c, str)],
     )
     return Diagnosis(text, notes)
 

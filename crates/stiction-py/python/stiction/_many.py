@@ -88,7 +88,7 @@ def diagnose_many(
     mode: Optional[str] = None,
     mv: Optional[str] = None,
     ts: Optional[float] = None,
-    integrating: bool = False,
+    integrating: Optional[bool] = None,
     quantify: bool = True,
     *,
     time: Optional[str] = None,
@@ -138,6 +138,7 @@ def diagnose_many(
     text = _native.diagnose_many(
         names, sources, starts.tolist(), sig["op"], sig["pv"], sp=sig["sp"], mv=sig["mv"],
         auto=sig["auto"], time=t, ts=ts, integrating=integrating, quantify=quantify,
+        tags=[c for c in (pv, op) if isinstance(c, str)],
         op_range=tuple(op_range), estimate_start=estimate_start, thorough=thorough, time_name=time_name,
         threads=threads, progress=progress, failed={g: f"{sources[g]}: {w}" for g, w in bad.items()},
     )

@@ -69,7 +69,7 @@ def report(
     mode: Any = None,
     mv: Any = None,
     ts: Optional[float] = None,
-    integrating: bool = False,
+    integrating: Optional[bool] = None,
     window: Optional[int] = None,
     path: Union[str, "os.PathLike[str]", None] = None,
     *,

@@ -22,13 +22,14 @@ def diagnose(
     auto: Optional[npt.NDArray[np.bool_]] = None,
     time: Optional[npt.NDArray[np.float64]] = None,
     ts: Optional[float] = None,
-    integrating: bool = False,
+    integrating: Optional[bool] = None,
     window: Optional[int] = None,
     quantify: bool = True,
     op_range: Tuple[float, float] = (0.0, 100.0),
     estimate_start: bool = False,
     thorough: bool = False,
     time_name: Optional[str] = None,
+    tags: Optional[List[str]] = None,
 ) -> Tuple[str, List[str]]:
     """Diagnose one loop: the Diagnosis as the CLI's ``diagnose --json`` text (the reasons' and
     the next step's ``text`` filled by the same words), and the notes of the record's
@@ -42,7 +43,7 @@ def report(
     auto: Optional[npt.NDArray[np.bool_]] = None,
     time: Optional[npt.NDArray[np.float64]] = None,
     ts: Optional[float] = None,
-    integrating: bool = False,
+    integrating: Optional[bool] = None,
     window: Optional[int] = None,
     quantify: bool = True,
     op_range: Tuple[float, float] = (0.0, 100.0),
@@ -68,7 +69,7 @@ def diagnose_many(
     auto: Optional[npt.NDArray[np.bool_]] = None,
     time: Optional[npt.NDArray[np.float64]] = None,
     ts: Optional[float] = None,
-    integrating: bool = False,
+    integrating: Optional[bool] = None,
     quantify: bool = True,
     op_range: Tuple[float, float] = (0.0, 100.0),
     estimate_start: bool = False,
@@ -77,6 +78,7 @@ def diagnose_many(
     threads: Optional[int] = None,
     progress: bool = False,
     failed: Optional[Dict[int, str]] = None,
+    tags: Optional[List[str]] = None,
 ) -> str:
     """Diagnose many loops: the ranked fleet rows as JSON (``stiction batch``'s summary rows:
     ``probability`` of a sticky valve, ``reason`` the reasons' words joined by "; ")."""

@@ -58,7 +58,7 @@ def diagnose(
     mode: Optional[str] = None,
     mv: Optional[str] = None,
     ts: Optional[float] = None,
-    integrating: bool = False,
+    integrating: Optional[bool] = None,
     quantify: bool = True,
     *,
     time: Optional[str] = None,

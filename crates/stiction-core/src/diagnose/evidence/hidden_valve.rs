@@ -161,8 +161,7 @@ impl EvidenceFamily for HiddenValve {
         // a sine on the load under setpoint steps, PV's strongest cycle was the steps', and the
         // sine left to the sticky hypothesis reached a ratio of 185)
         let period = ctx.oscillation.period.map(|p| p / ctx.req.ts);
-        let Some((t, draws, evaluations)) = drawn(&rec, hi - lo, ctx.req.integrating, period)
-        else {
+        let Some((t, draws, evaluations)) = drawn(&rec, hi - lo, ctx.integrating, period) else {
             return abstain("PV does not move above its resolution: nothing to filter".into());
         };
         let pct = 100.0 * t.band / (hi - lo);

@@ -152,6 +152,8 @@ pub struct Context<'a> {
     /// The setpoint the control error is taken from: SP when recorded, else the setpoint read
     /// off the record ([`crate::diagnose::setpoint`]), if any.
     pub setpoint: Option<&'a [f64]>,
+    /// The loop is integrating (as the request says, or as the record behaves).
+    pub integrating: bool,
     /// The recorded valve position (mv) over the analysed stretch, OP units, when recorded.
     pub mv: Option<&'a [f64]>,
     /// The control error (SP - PV; without SP, PV's deviation from the setpoint read off the

@@ -58,7 +58,7 @@ impl EvidenceFamily for Shape {
             &ctx.error[s..e],
             osc,
             ctx.req.ts,
-            ctx.req.integrating,
+            ctx.integrating,
         );
         let (_, score, _) = combine(&idx, ctx.req.verdict_margin);
         // a compressed PV (repeats, or exactly straight lines between stored points, in more of

@@ -33,7 +33,8 @@ pub enum Statistic {
     /// triangles and squares); 0 without a cycle.
     CycleShape,
     /// The phase lag, degrees, a valve must add for the identified linear loop to sustain the
-    /// observed cycle (the linear-loop family); 0 without a cycle.
+    /// observed cycle, where a sticky valve's describing function gives it (at most 90°, the
+    /// balance closed); 0 where no valve gives it (the linear-loop family).
     LoopLag,
 }
 

@@ -9,6 +9,10 @@ use crate::diagnose::reasons::Finding;
 /// drive PV's cycle.
 const MIN_EXPLAINED: f64 = 0.3;
 
+/// A sticky valve's describing function gives the loop's needed lag and gain within this
+/// distance (the loop family's tolerance).
+const MAX_DESCRIBING: f64 = 0.2;
+
 /// The statistics of one judged stretch (`None`: not measured there).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Measured([Option<f64>; Statistic::ALL.len()]);
@@ -50,7 +54,23 @@ impl Measured {
                 Statistic::CycleShape => family(families, Family::Shape)
                     .and_then(|f| f.value)
                     .filter(|_| driven),
-                Statistic::LoopLag => family(families, Family::Loop).and_then(|f| f.value),
+                // the lag a valve must add, where a sticky valve's describing function gives it
+                // (at most a quarter period, the balance closed within its tolerance); a lag no
+                // valve gives reads 0
+                Statistic::LoopLag => family(families, Family::Loop)
+                    .and_then(|f| f.limit_cycle.as_ref())
+                    .map(|l| {
+                        let given = l
+                            .describing
+                            .as_ref()
+                            .is_some_and(|d| d.distance <= MAX_DESCRIBING);
+                        let lag = l.needed_lag_degrees;
+                        if given && (0.0..=90.0).contains(&lag) {
+                            lag
+                        } else {
+                            0.0
+                        }
+                    }),
             }
             .and_then(finite);
         }

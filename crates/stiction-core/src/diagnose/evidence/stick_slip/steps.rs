@@ -12,7 +12,8 @@
 //!   process still moving is not a stick);
 //! - the control error held an offset the integral action winds OP against;
 //! - the step went the way OP pushed (through the controller's sign), and came at least a few
-//!   samples after any setpoint change (a setpoint step moves PV through a healthy valve too).
+//!   samples after any setpoint change (a setpoint step moves PV through a healthy valve too);
+//! - PV landed: it holds at its new level (a slow process's rise after its dead time goes on).
 //!
 //! The share of PV's steps that end a stick is the family's statistic: a healthy valve's PV
 //! steps follow loads and setpoint changes, a sticky valve's follow OP's winding.
@@ -231,7 +232,10 @@ pub fn steps(s: &Signals, set: &StepSettings) -> Steps {
             continue;
         };
         out.steps += 1;
-        if let Some(stick) = stick(s, set, a, all[j].start, means[j] - means[i], &changed) {
+        // a slip lands: PV holds at its new level (a slow process's rise goes on through it)
+        let step = means[j] - means[i];
+        let landed = trend(&s.pv[all[j].start..all[j].end]).abs() <= set.flatness * step.abs();
+        if let Some(stick) = stick(s, set, a, all[j].start, step, &changed).filter(|_| landed) {
             out.sticks.push(stick);
         }
         i = j;
