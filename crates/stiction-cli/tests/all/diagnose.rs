@@ -696,7 +696,15 @@ fn a_tag_in_a_column_name_hints_the_loops_kind() {
     let tagged = dir.path().join("tagged.csv");
     std::fs::write(&tagged, text.replacen("pv", "LIC101.PV", 1)).unwrap();
     let t = tagged.to_str().unwrap();
-    let v = json(&ok(&["diagnose", t, "--pv", "LIC101.PV", "--sp", "sp", "--json"]));
+    let v = json(&ok(&[
+        "diagnose",
+        t,
+        "--pv",
+        "LIC101.PV",
+        "--sp",
+        "sp",
+        "--json",
+    ]));
     assert_eq!(v["loop_kind"]["integrating"], true, "{v:#}");
     assert_eq!(v["loop_kind"]["from"], "tag", "{v:#}");
     assert_eq!(v["loop_kind"]["tag"], "LIC101", "{v:#}");
