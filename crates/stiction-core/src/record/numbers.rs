@@ -33,8 +33,22 @@ impl Grouping {
     }
 }
 
+/// A cell in the plain form most exports write (`-12.5`, `3e-4`): digits, at most one point, a
+/// sign or an exponent, no comma or space. Every convention reads it alike, except that a column
+/// grouped by points reads no point as a decimal mark.
+fn plain(c: &str) -> bool {
+    let b = c.as_bytes();
+    !b.is_empty()
+        && b.iter()
+            .all(|&x| x.is_ascii_digit() || matches!(x, b'.' | b'-' | b'+' | b'e' | b'E'))
+        && b.iter().filter(|&&x| x == b'.').count() <= 1
+}
+
 /// The grouping a single cell shows beyond doubt.
 fn unambiguous(c: &str) -> Grouping {
+    if plain(c) {
+        return Grouping::None;
+    }
     let (commas, points) = (c.matches(',').count(), c.matches('.').count());
     let last_comma = c.rfind(',');
     let last_point = c.rfind('.');
@@ -118,6 +132,9 @@ pub fn parse_number(cell: &str) -> Option<f64> {
 /// [`parse_number`] in a column whose convention is `g` ([`Grouping::of`]): with commas
 /// grouping, `12,345` is 12345; with points grouping, `1.234` is 1234 and `12,5` is 12.5.
 pub fn parse_number_grouped(cell: &str, g: Grouping) -> Option<f64> {
+    if g != Grouping::Point && plain(cell) {
+        return cell.parse().ok();
+    }
     let owned = space_grouped(cell);
     let cell = owned.as_deref().unwrap_or(cell);
     if let Some(v) = match g {
