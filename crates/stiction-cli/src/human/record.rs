@@ -58,6 +58,9 @@ pub fn print(d: &Diagnosis) {
         d.analysed[1],
         count(d.stretches.len(), "usable stretch", "usable stretches")
     );
+    if let Some(j) = &d.judged_on {
+        println!("  {}", crate::words::judged_on(j, d.analysed));
+    }
     oscillation(d);
     if let Some(r) = &d.setpoint_read_off {
         println!("  {}", read_off(r));

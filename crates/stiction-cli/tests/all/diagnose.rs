@@ -802,3 +802,24 @@ fn settings_print_the_table_and_the_verdicts_model() {
     // without --settings a file is needed
     fails(&["diagnose"], &["FILE"]);
 }
+
+#[test]
+fn a_long_record_is_judged_on_its_means_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "long.csv", "2", &["--samples", "24000"]);
+    let v = json(&ok(&["diagnose", &f, "--sp", "sp", "--json"]));
+    assert_eq!(v["verdict"], "stiction", "{v:#}");
+    let on = &v["judged_on"];
+    let over = on["over"].as_u64().unwrap();
+    assert!(over > 1, "{on:#}");
+    assert!(on["samples"].as_u64().unwrap() >= 2000, "{on:#}");
+    let text = ok(&["diagnose", &f, "--sp", "sp"]);
+    assert!(
+        text.contains(&format!("judged on means of {over} samples")),
+        "{text}"
+    );
+    // a record of the usual length is judged sample by sample, and the JSON says nothing of it
+    let short = simulate(dir.path(), "short.csv", "2", &[]);
+    let v = json(&ok(&["diagnose", &short, "--sp", "sp", "--json"]));
+    assert!(v.get("judged_on").is_none(), "{v:#}");
+}

@@ -16,6 +16,7 @@
 //! - [`reach`]: the bands a record like this one shows and hides, from OP's noise;
 //! - `windows`: the same judgement per window of the record.
 
+pub mod averaging;
 mod band;
 mod bridge;
 pub mod evidence;
@@ -32,6 +33,7 @@ mod stretch;
 mod verdict;
 mod windows;
 
+pub use averaging::{AveragingSettings, JudgedOn};
 pub use evidence::{Family, FamilyEvidence};
 pub use oscillation::noise_std;
 pub use reach::Reach;
@@ -251,6 +253,7 @@ pub fn diagnose_checked(
         windows,
         setpoint_read_off: None,
         loop_kind: None,
+        judged_on: None,
         warnings,
         seconds: 0.0,
     };
@@ -262,12 +265,36 @@ pub fn diagnose_checked(
     if let Some((reason, action)) = gates::still(sub.op, sub.pv) {
         return Ok(unjudged(d, reason, action, started));
     }
+    // a long record is judged on its means at the loop's own time scale
+    let settings = &req.settings.averaging;
+    let (over, time_scale) = averaging::factor(&sub, settings);
+    let means = (over > 1).then(|| averaging::Means::of(&sub, over));
+    let averaged_req;
+    let (sub, req) = match &means {
+        Some(m) => {
+            averaged_req = DiagnoseRequest {
+                ts: req.ts * over as f64,
+                ..(**req).clone()
+            };
+            (m.record(), &averaged_req)
+        }
+        None => (sub, &**req),
+    };
+    // ... and a fast loop's on the part where OP moves most
+    let from = averaging::most_moving(sub.op, settings.max_samples);
+    let judged = sub.op.len().min(settings.max_samples);
+    let whole = sub.op.len();
+    let sub = sub.slice(from, from + judged);
+    // a judged sample `k` is the record's sample `base + k * over`
+    let base = s + from * over;
     let j = judge(&sub, req);
     if let Some(read) = &j.setpoint {
         if let Some(w) = d.warnings.iter_mut().find(|w| w.starts_with(NO_SETPOINT)) {
             *w = setpoint::words(read.steps.len());
         }
-        d.setpoint_read_off = Some(read.in_record(s));
+        let mut read = read.in_record(0);
+        read.steps.iter_mut().for_each(|k| *k = base + *k * over);
+        d.setpoint_read_off = Some(read);
     }
     d.verdict = j.decision.verdict;
     d.probability = j.decision.probability;
@@ -282,13 +309,51 @@ pub fn diagnose_checked(
     d.indices = j.indices;
     d.reach = reach::of(&d, sub.op, req);
     let mut osc = j.oscillation;
-    osc.stretch = [osc.stretch[0] + s, osc.stretch[1] + s];
     if d.verdict == Verdict::Stiction {
-        band::size(&mut d, &sub, s, &osc, j.fits.as_ref(), req);
+        band::size(&mut d, &sub, 0, &osc, j.fits.as_ref(), req);
+    }
+    osc.stretch = osc.stretch.map(|k| base + k * over);
+    in_record_samples(&mut d, (base, over), base - s);
+    if over > 1 || judged < whole {
+        d.judged_on = Some(averaging::JudgedOn {
+            over,
+            ts: req.ts,
+            samples: judged,
+            time_scale,
+            stretch: [base, base + judged * over],
+        });
+    }
+    if judged < whole {
+        d.warnings.push(format!(
+            "judged on samples {base} to {} of the record: the {judged} {} where OP moves most; \
+             the analysed stretch holds {} times the loop's time scale and its evidence many times over",
+            base + judged * over,
+            if over > 1 { "means" } else { "samples" },
+            whole * over / time_scale.max(1)
+        ));
     }
     d.oscillation = Some(osc);
     d.seconds = started.elapsed().as_secs_f64();
     Ok(d)
+}
+
+/// The sample ranges the diagnosis reports, as samples of the record (a judged sample `k` is
+/// `base + k * over`): the closed-loop estimate's, and the sticks' and the hold's as samples of
+/// the analysed stretch (which starts `shift` samples before `base`); the families' other
+/// figures stay in judged samples.
+fn in_record_samples(d: &mut Diagnosis, (base, over): (usize, usize), shift: usize) {
+    if let Some(q) = &mut d.quantified {
+        *q = q.map(|k| base + k * over);
+    }
+    for f in &mut d.families {
+        if let Some(st) = &mut f.stick_slip {
+            let at = |k: usize| shift + k * over;
+            st.ranges.iter_mut().for_each(|r| *r = r.map(at));
+            if let Some(r) = &mut st.stuck_range {
+                *r = r.map(at);
+            }
+        }
+    }
 }
 
 /// `d` as `insufficient_data` (its default verdict) for `reason`, with the next step.

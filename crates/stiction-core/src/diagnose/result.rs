@@ -296,6 +296,10 @@ pub struct Diagnosis {
     /// The samples `[start, end)` the closed-loop estimate used.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub quantified: Option<[usize; 2]>,
+    /// What of a long record was judged and at what resolution (absent where every sample of
+    /// the analysed stretch was): the families' figures in samples are then in means of it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub judged_on: Option<super::averaging::JudgedOn>,
     /// A verdict per window, when the request asks for windows.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub windows: Vec<WindowVerdict>,

@@ -3,6 +3,7 @@
 //! ([`super::DiagnoseRequest::check`]); the guide's page on the verdict prints the table
 //! (`stiction diagnose --settings`).
 
+use super::averaging::AveragingSettings;
 use super::evidence::stick_slip::{StepSettings, StuckSettings};
 use super::request::DiagnoseError;
 use serde::{Deserialize, Serialize};
@@ -17,6 +18,9 @@ pub struct Settings {
     /// How a hold of PV off the setpoint is told (the stick-slip family).
     #[serde(default)]
     pub stuck: StuckSettings,
+    /// How a long record is averaged before it is judged.
+    #[serde(default)]
+    pub averaging: AveragingSettings,
 }
 
 impl Settings {
@@ -75,6 +79,10 @@ impl Settings {
         at_least("settings.stuck.min_samples", h.min_samples, 2)?;
         positive("settings.stuck.offset", h.offset)?;
         share("settings.stuck.spread", h.spread)?;
+        let a = &self.averaging;
+        at_least("settings.averaging.min_samples", a.min_samples, 2)?;
+        positive("settings.averaging.per_time_scale", a.per_time_scale)?;
+        at_least("settings.averaging.max_samples", a.max_samples, 2)?;
         Ok(())
     }
 }

@@ -35,6 +35,7 @@
 //! the noise's standard deviation): a loop that does not is drawn again from the next seed (up to
 //! [`MAX_ATTEMPTS`] times; the attempts are recorded).
 
+mod day;
 mod draw;
 mod fast;
 mod kinds;
@@ -43,6 +44,7 @@ mod routine;
 mod tuning;
 mod windows;
 
+pub use day::{day_class, plant_day};
 pub use fast::issue14_example;
 pub use kinds::{BenchmarkLoop, Cycle, Excitation, LoopClass, LoopKind, NoiseLevel, Truth, Tuning};
 pub use tuning::LinearLoop;

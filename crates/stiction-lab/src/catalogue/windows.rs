@@ -16,6 +16,25 @@ use stiction_core::sim::{ClosedLoop, Pi, Process, Signal};
 const SAMPLES: usize = 750;
 const TS: f64 = 10.0;
 
+/// How a drawn loop is recorded: its samples, their spacing, and whether each is the mean of the
+/// loop's 1-s values over its interval (a historian's average) or the 1-s value itself.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shape {
+    /// Samples in the record.
+    pub samples: usize,
+    /// Seconds between them.
+    pub ts: f64,
+    /// Each sample the mean over its interval.
+    pub average: bool,
+}
+
+/// The plant window: 750 10-s averages.
+pub const WINDOW: Shape = Shape {
+    samples: SAMPLES,
+    ts: TS,
+    average: true,
+};
+
 fn kind_of(class: LoopClass, d: &mut Draw) -> LoopKind {
     match class {
         LoopClass::SlowLongDelay => d.pick(&[LoopKind::Temperature, LoopKind::Analyser]),
@@ -104,7 +123,9 @@ fn operator_setpoint(total: f64, warmup: f64, d: &mut Draw) -> (Signal, usize) {
     let dt = 1.0;
     let n = (total / dt) as usize + 2;
     let mut sp = vec![50.0; n];
-    let moves = d.pick(&[0usize, 0, 1, 1, 2, 2, 3, 4, 5]);
+    // as many moves per window's length in a longer record
+    let windows = ((total - warmup) / (SAMPLES as f64 * TS)).round().max(1.0) as usize;
+    let moves = d.pick(&[0usize, 0, 1, 1, 2, 2, 3, 4, 5]) * windows;
     let mut steps = 0;
     for _ in 0..moves {
         let mut at = warmup + d.uniform(0.0, total - warmup);
@@ -148,20 +169,28 @@ fn plant_valve(class: LoopClass, d: &mut Draw) -> Model {
 
 /// A plant window of `class`.
 pub fn build(class: LoopClass, d: &mut Draw) -> Built {
+    build_shaped(class, d, WINDOW)
+}
+
+/// A loop of `class` drawn as a plant window's is (the same processes, tunings and operators),
+/// recorded as `shape` says: a day at 1 s is `Shape { samples: 86_400, ts: 1.0, average: false }`.
+pub fn build_shaped(class: LoopClass, d: &mut Draw, shape: Shape) -> Built {
+    // the draws (tuning, periods, holds) read the plant window's length, whatever the record's
     let window = SAMPLES as f64 * TS;
+    let record = shape.samples as f64 * shape.ts;
     let kind = kind_of(class, d);
     let (process, lag) = process(kind, d);
     let noise_level = noise(d);
     let mut cl = ClosedLoop::new(plant_valve(class, d));
     cl.process = process;
-    cl.ts = TS;
-    cl.samples = SAMPLES;
+    cl.ts = shape.ts;
+    cl.samples = shape.samples;
     cl.controller_period = Some(1.0);
     cl.substeps = Some(1);
     cl.valve_lag = lag;
     // raw 1-s noise; the 10-s means carry about a third of it
     cl.noise = noise_level.std() * d.uniform(1.0, 3.0);
-    cl.historian.average = true;
+    cl.historian.average = shape.average;
     cl.seed = d.seed();
     cl.op0 = d.uniform(15.0, 85.0);
     cl.warmup = window / 4.0;
@@ -173,7 +202,7 @@ pub fn build(class: LoopClass, d: &mut Draw) -> Built {
     };
     let (pi, tuning) = tune(class, &lin, d);
     cl.pi = pi;
-    let total = cl.warmup + window;
+    let total = cl.warmup + record;
     let (setpoint, steps) = operator_setpoint(total, cl.warmup, d);
     cl.setpoint = setpoint;
     // loads drift less on the real plant's healthy windows than in the routine suite: OP winds

@@ -341,3 +341,19 @@ fn the_ultimate_gain_is_the_linear_loops_stability_limit() {
     assert!((lin.effective_delay() - 6.0).abs() < 1e-12);
     assert!((pi.kc - 30.0 / (1.0 * 12.0)).abs() < 1e-12 && pi.ti == 30.0);
 }
+
+#[test]
+fn a_plant_day_is_one_sticky_valve_in_ten_drawn_the_same_at_every_run() {
+    let sticky = (0..100)
+        .filter(|&i| stiction_lab::catalogue::day_class(i).truth() == Truth::Sticky)
+        .count();
+    assert_eq!(sticky, 10);
+    let a = stiction_lab::catalogue::plant_day(1, 3_000);
+    let b = stiction_lab::catalogue::plant_day(1, 3_000);
+    assert_eq!(a.data.pv, b.data.pv);
+    assert_eq!((a.data.op.len(), a.ts()), (3_000, 1.0));
+    assert_eq!(
+        stiction_lab::catalogue::plant_day(0, 3_000).truth,
+        Truth::Sticky
+    );
+}

@@ -55,7 +55,8 @@ class Diagnosis(_Result):
     its ``contribution`` to the log-odds), ``indices`` (the shape indices), ``oscillation``,
     ``quality`` (the data-quality gates), ``samples``, ``ts``, ``warnings``; without a setpoint
     column, ``setpoint_read_off`` (the setpoint's steps read off OP and PV, and the levels
-    between) when any were found. The words are the CLI's (the same Rust code fills them).
+    between) when any were found; on a long record, ``judged_on`` (the means it was judged on,
+    and the samples). The words are the CLI's (the same Rust code fills them).
     """
 
     @property

@@ -155,7 +155,7 @@ pub fn build(loop_id: &str, data: &LoopData, d: &Diagnosis, o: &PageOptions) -> 
 fn meta(data: &LoopData, d: &Diagnosis) -> String {
     let [s, e] = d.analysed;
     format!(
-        "{} samples at {} s, {} in all; analysed samples {s} to {e}{}{}.",
+        "{} samples at {} s, {} in all; analysed samples {s} to {e}{}{}{}.",
         d.samples,
         num(d.ts),
         duration(d.samples as f64 * d.ts),
@@ -165,6 +165,10 @@ fn meta(data: &LoopData, d: &Diagnosis) -> String {
             ""
         },
         setpoint_words(data.sp, [s, e]),
+        d.judged_on.as_ref().map_or(String::new(), |j| format!(
+            "; {}",
+            crate::words::judged_on(j, d.analysed)
+        )),
     )
 }
 

@@ -48,6 +48,35 @@ pub fn seconds(s: f64) -> String {
     }
 }
 
+/// What of a long record was judged, in words: "judged on means of 29 samples (29 s), 2061 of
+/// them" or "judged on samples 5000 to 25000, where OP moves most".
+pub fn judged_on(j: &stiction_core::diagnose::averaging::JudgedOn, analysed: [usize; 2]) -> String {
+    let mut out = String::from("judged on ");
+    if j.over > 1 {
+        out.push_str(&format!(
+            "means of {} samples ({} s), {} of them",
+            j.over,
+            seconds(j.ts),
+            j.samples
+        ));
+    }
+    if j.stretch
+        != [
+            analysed[0],
+            analysed[0] + (analysed[1] - analysed[0]) / j.over * j.over,
+        ]
+    {
+        if j.over > 1 {
+            out.push_str(", over ");
+        }
+        out.push_str(&format!(
+            "samples {} to {}, where OP moves most",
+            j.stretch[0], j.stretch[1]
+        ));
+    }
+    out
+}
+
 /// A verdict in words: "no stiction", "insufficient data".
 pub fn verdict(v: Verdict) -> &'static str {
     match v {

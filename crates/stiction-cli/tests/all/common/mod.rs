@@ -54,11 +54,12 @@ pub fn closed_stenman(path: &Path, d: &str, extra: &[&str]) {
         "stenman",
         "--param",
         &param,
-        "--samples",
-        "1500",
         "-o",
         path.to_str().unwrap(),
     ];
+    if !extra.contains(&"--samples") {
+        args.extend_from_slice(&["--samples", "1500"]);
+    }
     args.extend_from_slice(extra);
     ok(&args);
 }

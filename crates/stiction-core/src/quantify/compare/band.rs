@@ -140,7 +140,10 @@ pub(super) fn exact_band(
     let n = op.len();
     let whole = problems(op, data, structures, (lag, r.over), x0);
     let mut walked = 0;
-    let outcomes = if n >= STAGE_FROM && stage_sees_the_travel(op, r.first_samples()) {
+    let outcomes = if n >= STAGE_FROM
+        && r.first_samples() > lag
+        && stage_sees_the_travel(op, r.first_samples())
+    {
         let m = r.first_samples();
         let first = Data::new(&y[..m - lag], data.t0);
         let staged = problems(&op[..m], &first, structures, (lag, r.over), x0);

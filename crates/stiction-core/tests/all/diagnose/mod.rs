@@ -1,6 +1,7 @@
 //! The diagnosis: usable stretches, the families of evidence, the verdict, windows. The
 //! helpers here are shared by the parts.
 
+mod long;
 mod record;
 mod shape;
 
