@@ -121,12 +121,16 @@ pub fn levels(pv: &[f64], beta: f64, max_level: usize) -> Vec<Level> {
     let mut last = vec![0usize; n + 1];
     let mut candidates: Vec<usize> = vec![0];
     let mut kept: Vec<usize> = Vec::new();
+    // each candidate's cost to `t`, computed once for the minimum and the pruning
+    let mut to_t: Vec<f64> = Vec::new();
     for t in 1..=n {
         let (mut f, mut arg) = (f64::INFINITY, 0);
+        to_t.clear();
         for &c in &candidates {
-            let v = best[c] + cost(c, t) + beta;
-            if v < f {
-                (f, arg) = (v, c);
+            let v = best[c] + cost(c, t);
+            to_t.push(v);
+            if v + beta < f {
+                (f, arg) = (v + beta, c);
             }
         }
         best[t] = f;
@@ -135,8 +139,9 @@ pub fn levels(pv: &[f64], beta: f64, max_level: usize) -> Vec<Level> {
         kept.extend(
             candidates
                 .iter()
-                .copied()
-                .filter(|&c| best[c] + cost(c, t) <= f && t - c < max_level),
+                .zip(&to_t)
+                .filter(|&(&c, &v)| v <= f && t - c < max_level)
+                .map(|(&c, _)| c),
         );
         if kept.is_empty() {
             kept.push(arg);
