@@ -24,7 +24,7 @@ fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("diagnose");
     g.sample_size(10);
     for (name, d) in [("sticky", 2.0), ("healthy", 0.0)] {
-        for n in [2000, 10_000] {
+        for n in [2000, 10_000, 86_400] {
             let mut cl = ClosedLoop::new(Model::Stenman(Stenman { d }));
             cl.samples = n;
             cl.noise = 0.05;
@@ -48,8 +48,17 @@ fn benches(c: &mut Criterion) {
                     },
                 ),
             ];
+            if n == 86_400 {
+                // a day at 1 s, beside the same record judged sample by sample (no means, no
+                // part): what averaging at the loop's time scale saves
+                let mut every = DiagnoseRequest::default();
+                every.settings.averaging.min_samples = usize::MAX;
+                every.settings.averaging.max_time_scales = usize::MAX;
+                named.push((format!("{name}_{n}_every_sample"), every));
+            }
             if n == 2000 {
-                // --thorough: the model family's levels test besides (a fit per Stenman valve)
+                // --thorough: the hidden-valve family besides (it reports; the model does not
+                // read it)
                 named.push((
                     format!("{name}_{n}_thorough_without_quantify"),
                     DiagnoseRequest {

@@ -26,7 +26,7 @@ fn timed(l: &BenchmarkLoop, runs: usize, every_sample: bool) -> (f64, Diagnosis)
     let mut req = request(l);
     if every_sample {
         req.settings.averaging.min_samples = usize::MAX;
-        req.settings.averaging.max_samples = usize::MAX;
+        req.settings.averaging.max_time_scales = usize::MAX;
     }
     let mut best = f64::INFINITY;
     let mut last = None;

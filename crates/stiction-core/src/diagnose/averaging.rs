@@ -4,10 +4,10 @@
 //! values), at a fraction of the cost. The means span a share of the time over which OP's and
 //! PV's own variation (their noise set aside) loses half its correlation, so no change the
 //! families read is averaged away; a record is never averaged below
-//! [`AveragingSettings::min_samples`] means. A fast loop's record that still holds more than
-//! [`AveragingSettings::max_samples`] means (thousands of its time scales) is judged on that many,
-//! where OP moves most: its evidence is there many times over, and the fits' cost grows faster
-//! than the record.
+//! [`AveragingSettings::min_samples`] means. A fast loop's record whose means still hold more than
+//! [`AveragingSettings::max_time_scales`] of its half-decay times is judged on that many (never
+//! fewer than `min_samples` means), where OP moves most: its evidence is there many times over,
+//! and the fits' cost grows faster than the record.
 
 use crate::quality::Record;
 use serde::{Deserialize, Serialize};
@@ -21,8 +21,9 @@ pub struct AveragingSettings {
     /// Means per half-decay time: the time over which the slower-decorrelating of OP and PV (the
     /// faster of the two read) keeps half its correlation, noise set aside.
     pub per_time_scale: f64,
-    /// Most means judged: a longer record of means is judged on this many, where OP moves most.
-    pub max_samples: usize,
+    /// Most half-decay times judged: a record of means that holds more is judged on this many
+    /// (at least `min_samples` means), where OP moves most.
+    pub max_time_scales: usize,
 }
 
 impl Default for AveragingSettings {
@@ -30,7 +31,7 @@ impl Default for AveragingSettings {
         Self {
             min_samples: 2_000,
             per_time_scale: 8.0,
-            max_samples: 20_000,
+            max_time_scales: 2_000,
         }
     }
 }
@@ -48,8 +49,8 @@ pub struct JudgedOn {
     /// The half-decay time the means were sized to, samples of the record (0 where the record
     /// was too short to average).
     pub time_scale: usize,
-    /// The record's samples `[start, end)` judged: the analysed stretch, or where the means
-    /// outnumber `max_samples`, the part of it where OP moves most.
+    /// The record's samples `[start, end)` judged: the analysed stretch, or where its means hold
+    /// more than `max_time_scales` half-decay times, the part of it where OP moves most.
     pub stretch: [usize; 2],
 }
 
@@ -85,8 +86,18 @@ pub(super) fn most_moving(op: &[f64], len: usize) -> usize {
         .0
 }
 
+/// The most means judged when a mean spans `over` samples of a loop whose half-decay time is
+/// `time_scale` samples (0: unknown, no bound).
+pub(super) fn most_judged(set: &AveragingSettings, over: usize, time_scale: usize) -> usize {
+    if time_scale == 0 {
+        return usize::MAX;
+    }
+    let held = set.max_time_scales.saturating_mul(time_scale) / over.max(1);
+    held.max(set.min_samples)
+}
+
 /// The samples a mean spans for the stretch `r` (1: judged sample by sample), and the
-/// half-decay time it was sized to.
+/// half-decay time it was sized to (0 for a record too short to average).
 pub(super) fn factor(r: &Record, set: &AveragingSettings) -> (usize, usize) {
     let n = r.op.len();
     let most = n / set.min_samples.max(1);

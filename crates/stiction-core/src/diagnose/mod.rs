@@ -281,8 +281,9 @@ pub fn diagnose_checked(
         None => (sub, &**req),
     };
     // ... and a fast loop's on the part where OP moves most
-    let from = averaging::most_moving(sub.op, settings.max_samples);
-    let judged = sub.op.len().min(settings.max_samples);
+    let most = averaging::most_judged(settings, over, time_scale);
+    let from = averaging::most_moving(sub.op, most);
+    let judged = sub.op.len().min(most);
     let whole = sub.op.len();
     let sub = sub.slice(from, from + judged);
     // a judged sample `k` is the record's sample `base + k * over`

@@ -82,7 +82,7 @@ impl Settings {
         let a = &self.averaging;
         at_least("settings.averaging.min_samples", a.min_samples, 2)?;
         positive("settings.averaging.per_time_scale", a.per_time_scale)?;
-        at_least("settings.averaging.max_samples", a.max_samples, 2)?;
+        at_least("settings.averaging.max_time_scales", a.max_time_scales, 1)?;
         Ok(())
     }
 }

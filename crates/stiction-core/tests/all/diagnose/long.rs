@@ -31,15 +31,16 @@ fn a_long_sticky_record_is_judged_on_its_means() {
 }
 
 #[test]
-fn a_record_of_more_means_than_the_most_is_judged_where_op_moves_most() {
+fn a_record_of_more_time_scales_than_the_most_is_judged_where_op_moves_most() {
     let healthy = run(0.0, |cl| cl.samples = 6_000);
     let mut req = quick();
-    req.settings.averaging.min_samples = usize::MAX;
-    req.settings.averaging.max_samples = 2_500;
+    req.settings.averaging.min_samples = 1_000;
+    req.settings.averaging.max_time_scales = 10;
     let d = diagnose(&record(&healthy), &req).unwrap();
     let on = d.judged_on.as_ref().expect("a part judged");
-    assert_eq!((on.over, on.samples), (1, 2_500));
-    assert_eq!(on.stretch[1] - on.stretch[0], 2_500);
+    // ten half-decay times are fewer than the thousand means a record keeps
+    assert_eq!(on.samples, 1_000, "{on:?}");
+    assert_eq!(on.stretch[1] - on.stretch[0], 1_000 * on.over);
     assert!(
         d.warnings.iter().any(|w| w.contains("where OP moves most")),
         "{:?}",
