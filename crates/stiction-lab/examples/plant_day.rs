@@ -145,7 +145,7 @@ fn day_table(args: &StudyArgs, loops: usize, samples: usize, md: &mut String) {
 fn curve(to: usize, md: &mut String) {
     md.push_str("## Cost against the record's length\n\nThe same two draws (loop 0 sticky, loop 1 healthy) at every length; the fastest of three runs up to 100,000 samples, one beyond.\n\n");
     md.push_str("| samples | sticky s | judged on | healthy s | judged on | sticky / 2,000 | healthy / 2,000 |\n|---|---|---|---|---|---|---|\n");
-    let mut base = [f64::NAN; 2];
+    let mut rows = Vec::new();
     for &n in CURVE.iter().filter(|&&n| n <= to) {
         let mut row = format!("| {n} |");
         let mut secs = [0.0; 2];
@@ -160,16 +160,19 @@ fn curve(to: usize, md: &mut String) {
             let _ = write!(row, " {s:.4} | {judged} ({}) |", verdict_name(d.verdict));
             eprintln!("curve {n} {index} {s:.4}");
         }
-        if n == 2_000 {
-            base = secs;
-        }
+        rows.push((n, row, secs));
+    }
+    let base = rows
+        .iter()
+        .find(|r| r.0 == 2_000)
+        .map_or([f64::NAN; 2], |r| r.2);
+    for (_, row, secs) in rows {
         let _ = writeln!(
-            row,
-            " {:.1} | {:.1} |",
+            md,
+            "{row} {:.1} | {:.1} |",
             secs[0] / base[0],
             secs[1] / base[1]
         );
-        md.push_str(&row);
     }
 }
 

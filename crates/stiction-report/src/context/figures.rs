@@ -235,6 +235,10 @@ pub(super) fn phase(data: &LoopData, d: &Diagnosis, q: Option<&Quantification>) 
         "The measured PV against OP (grey) over the analysed stretch, and the PV the fitted model \
          simulates (red). While a sticky valve holds, OP moves and PV does not follow: the plot draws \
          a loop rather than a line."
+    } else if q.is_some() && d.judged_on.is_some() {
+        "The measured PV against OP over the analysed stretch. While a sticky valve holds, OP moves \
+         and PV does not follow: the plot draws a loop rather than a line. The model was fitted to \
+         the record's means (see the header), so its PV is not drawn over the samples."
     } else {
         "The measured PV against OP over the analysed stretch. While a sticky valve holds, OP moves \
          and PV does not follow: the plot draws a loop rather than a line. No model was fitted."
