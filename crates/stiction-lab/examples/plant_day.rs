@@ -40,16 +40,7 @@ fn timed(l: &BenchmarkLoop, runs: usize, every_sample: bool) -> (f64, Diagnosis)
 }
 
 fn write_csv(l: &BenchmarkLoop, path: &std::path::Path) {
-    let d = &l.data;
-    let mut csv = String::with_capacity(d.t.len() * 60);
-    csv.push_str("t,sp,op,mv,pv\n");
-    for i in 0..d.t.len() {
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{}",
-            d.t[i], d.sp[i], d.op[i], d.mv[i], d.pv[i]
-        );
-    }
+    let csv = stiction_lab::catalogue_loop::csv(l);
     std::fs::write(path, csv).unwrap_or_else(|e| {
         eprintln!("plant_day: {}: cannot write: {e}", path.display());
         std::process::exit(1)

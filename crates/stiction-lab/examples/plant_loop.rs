@@ -7,7 +7,6 @@
 //! (fast suite, calibration set), or `issue14`. The loop's description and the matching
 //! `stiction diagnose` command are printed on stderr.
 
-use std::fmt::Write as _;
 use std::process::exit;
 use stiction_lab::catalogue;
 
@@ -26,16 +25,7 @@ fn main() {
         );
         exit(2)
     };
-    let d = &l.data;
-    let mut csv = String::with_capacity(d.t.len() * 48);
-    csv.push_str("t,sp,op,mv,pv\n");
-    for i in 0..d.t.len() {
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{}",
-            d.t[i], d.sp[i], d.op[i], d.mv[i], d.pv[i]
-        );
-    }
+    let csv = stiction_lab::catalogue_loop::csv(&l);
     if let Err(e) = std::fs::write(path, csv) {
         eprintln!("plant_loop: {path}: cannot write the file: {e}");
         exit(1)
@@ -47,7 +37,7 @@ fn main() {
         l.truth.name(),
         l.slips,
         l.description,
-        d.t.len(),
+        l.data.t.len(),
         if l.integrating { " --integrating" } else { "" }
     );
 }

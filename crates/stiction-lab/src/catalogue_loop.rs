@@ -25,3 +25,19 @@ pub fn request(l: &BenchmarkLoop) -> DiagnoseRequest {
         ..DiagnoseRequest::default()
     }
 }
+
+/// The loop as the CSV file `stiction diagnose` reads: the columns `t,sp,op,mv,pv`.
+pub fn csv(l: &BenchmarkLoop) -> String {
+    use std::fmt::Write as _;
+    let d = &l.data;
+    let mut csv = String::with_capacity(d.t.len() * 60);
+    csv.push_str("t,sp,op,mv,pv\n");
+    for i in 0..d.t.len() {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{}",
+            d.t[i], d.sp[i], d.op[i], d.mv[i], d.pv[i]
+        );
+    }
+    csv
+}

@@ -29,7 +29,7 @@ pub struct RealRecord {
     /// Its source.
     pub source: RealSource,
     /// Flow, level, pressure, ... as labelled.
-    pub kind: String,
+    pub measurement: String,
     /// Controller output.
     pub op: Vec<f64>,
     /// Process variable.
@@ -103,7 +103,7 @@ pub fn plant_dev(dir: &Path) -> Option<Vec<RealRecord>> {
         let get = |name: &str| h.iter().position(|c| c == name).map(|i| r[i].clone());
         let file = get("file")?;
         let (hd, data) = read_csv(&dir.join(&file))?;
-        let ti = hd.iter().position(|c| c == "time")?;
+        let ti = hd.iter().position(|c| c.eq_ignore_ascii_case("time"))?;
         let time: Vec<f64> = data
             .iter()
             .map(|row| seconds(&row[ti]))
@@ -116,9 +116,9 @@ pub fn plant_dev(dir: &Path) -> Option<Vec<RealRecord>> {
         let group = parts.last().copied().unwrap_or(&name).to_string();
         out.push(RealRecord {
             group,
-            sticky: get("label")? == "stiction",
+            sticky: sticky_label(&get("label")?)?,
             source: RealSource::Plant,
-            kind: get("loop_kind")?,
+            measurement: get("loop_kind")?,
             op: column(&hd, &data, "op"),
             pv: column(&hd, &data, "pv"),
             sp: Some(column(&hd, &data, "sp")),
@@ -153,7 +153,7 @@ pub fn isdb(dir: &Path) -> Option<Vec<RealRecord>> {
             group: format!("ISDB_{}", r[li]),
             sticky: r[di] == "Y",
             source: RealSource::Isdb,
-            kind: r[mi].clone(),
+            measurement: r[mi].clone(),
             op: column(&hd, &data, "OP"),
             pv: column(&hd, &data, "PV"),
             sp: None,
@@ -171,6 +171,16 @@ pub fn all(shared: &Path) -> Option<Vec<RealRecord>> {
     let mut out = plant_dev(&shared.join("data/plant-dev"))?;
     out.extend(isdb(&shared.join("data/isdb"))?);
     Some(out)
+}
+
+/// A plant window's label: `stiction` is a sticky valve, `no_stiction` a healthy one; any other
+/// label is none of this study's.
+fn sticky_label(label: &str) -> Option<bool> {
+    match label {
+        "stiction" => Some(true),
+        "no_stiction" => Some(false),
+        _ => None,
+    }
 }
 
 #[cfg(test)]

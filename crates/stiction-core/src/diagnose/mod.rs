@@ -232,7 +232,7 @@ pub fn diagnose_checked(
     let windows = req
         .window
         .map_or_else(Vec::new, |w| windows::judge_windows(r, req, w, judge));
-    let mut d = Diagnosis {
+    let d = Diagnosis {
         verdict: Verdict::InsufficientData,
         probability: None,
         reasons: Vec::new(),
@@ -265,6 +265,18 @@ pub fn diagnose_checked(
     if let Some((reason, action)) = gates::still(sub.op, sub.pv) {
         return Ok(unjudged(d, reason, action, started));
     }
+    Ok(judge_stretch(d, sub, s, req, started))
+}
+
+/// Judge the analysed stretch `sub` (from sample `s` of the record) into `d`: on its means at the
+/// loop's time scale where it is long ([`averaging`]), then size the band on a `stiction` verdict.
+fn judge_stretch(
+    mut d: Diagnosis,
+    sub: LoopRecord,
+    s: usize,
+    req: &DiagnoseRequest,
+    started: Instant,
+) -> Diagnosis {
     // a long record is judged on its means at the loop's own time scale
     let settings = &req.settings.averaging;
     let (over, time_scale) = averaging::factor(&sub, settings);
@@ -274,11 +286,11 @@ pub fn diagnose_checked(
         Some(m) => {
             averaged_req = DiagnoseRequest {
                 ts: req.ts * over as f64,
-                ..(**req).clone()
+                ..req.clone()
             };
             (m.record(), &averaged_req)
         }
-        None => (sub, &**req),
+        None => (sub, req),
     };
     // ... and a fast loop's on the part where OP moves most
     let most = averaging::most_judged(settings, over, time_scale);
@@ -335,7 +347,7 @@ pub fn diagnose_checked(
     }
     d.oscillation = Some(osc);
     d.seconds = started.elapsed().as_secs_f64();
-    Ok(d)
+    d
 }
 
 /// The sample ranges the diagnosis reports, as samples of the record (a judged sample `k` is

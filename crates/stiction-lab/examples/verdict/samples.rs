@@ -111,7 +111,7 @@ pub fn real(shared: &Path) -> Option<Vec<Sample>> {
                     r.name.clone(),
                     r.group.clone(),
                     source,
-                    r.kind.clone(),
+                    r.measurement.clone(),
                     r.sticky,
                 )
             })

@@ -44,7 +44,7 @@ pub struct Evidence {
     /// How the probability is formed, in words.
     pub model: String,
     /// A family votes stiction from this share of the log-odds.
-    pub vote: String,
+    pub vote_from: String,
     pub statistics: Vec<StatisticRow>,
     pub families: Vec<FamilyBlock>,
     pub indices: Vec<IndexRow>,
@@ -188,7 +188,7 @@ pub fn evidence(d: &Diagnosis) -> Evidence {
     });
     Evidence {
         model: model_words(d),
-        vote: num(stiction_core::diagnose::VOTE),
+        vote_from: num(stiction_core::diagnose::VOTE),
         statistics: statistic_rows(d),
         families: d.families.iter().map(|f| family_block(f, d)).collect(),
         indices,
