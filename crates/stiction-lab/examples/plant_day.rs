@@ -169,15 +169,9 @@ fn curve(to: usize, md: &mut String) {
 
 fn main() {
     let args = StudyArgs::from_env("plant_day");
-    let number = |flag: &str, default: usize| {
-        args.value(flag).map_or(default, |v| {
-            v.parse()
-                .unwrap_or_else(|_| args.fail(&format!("{flag} {v}: give a whole number")))
-        })
-    };
-    let loops = number("--loops", 30);
-    let samples = number("--samples", 86_400);
-    let to = number("--curve-to", 1_000_000);
+    let loops = args.number("--loops", 30);
+    let samples = args.number("--samples", 86_400);
+    let to = args.number("--curve-to", 1_000_000);
     let mut md = String::from("# A plant's day\n\n`cargo run --release -p stiction-lab --example plant_day`: `diagnose` (the default request, SP given, as `stiction diagnose FILE --sp sp` reads a CSV) on loops drawn as the plant windows are, recorded at 1 s, one sticky valve in ten; one thread, in process.\n\n");
     day_table(&args, loops, samples, &mut md);
     curve(to, &mut md);

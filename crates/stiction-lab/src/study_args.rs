@@ -63,6 +63,15 @@ impl StudyArgs {
         }
     }
 
+    /// The number after `flag`, or `default` without it; exit 2 with one sentence if it does not
+    /// parse.
+    pub fn number<T: std::str::FromStr>(&self, flag: &str, default: T) -> T {
+        self.value(flag).map_or(default, |v| {
+            v.parse()
+                .unwrap_or_else(|_| self.fail(&format!("{flag} {v}: give a number")))
+        })
+    }
+
     /// Stop with exit code 2 and one sentence about a bad argument.
     pub fn fail(&self, message: &str) -> ! {
         eprintln!("{}: {message}", self.program);

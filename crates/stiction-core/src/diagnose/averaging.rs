@@ -205,14 +205,7 @@ mod tests {
     use super::*;
 
     fn record<'a>(op: &'a [f64], pv: &'a [f64]) -> Record<'a> {
-        Record {
-            op,
-            pv,
-            sp: None,
-            mv: None,
-            time: None,
-            auto: None,
-        }
+        Record::new(op, pv)
     }
 
     #[test]

@@ -73,12 +73,7 @@ fn collect(extra: u8) -> (Vec<Sample>, Vec<Sample>, bool) {
 
 fn main() {
     let args = StudyArgs::from_env("verdict");
-    let num = |flag: &str, default: f64| {
-        args.value(flag).map_or(default, |v| {
-            v.parse()
-                .unwrap_or_else(|_| args.fail(&format!("{flag} needs a number")))
-        })
-    };
+    let num = |flag: &str, default: f64| args.number(flag, default);
     let extra = num("--extra", 2.0) as u8;
     let plan = Plan {
         statistics: args
