@@ -109,6 +109,33 @@ fn benches(c: &mut Criterion) {
         ],
     );
     g.finish();
+    levels_bench(c);
+}
+
+/// The stick-slip family's segmentation of PV into levels (PELT) on 2,000 samples: noise about
+/// one level (where PELT prunes least) and a staircase of forty levels.
+fn levels_bench(c: &mut Criterion) {
+    use stiction_core::diagnose::evidence::stick_slip::steps::levels;
+    let mut g = c.benchmark_group("levels");
+    let mut x: u64 = 7;
+    let noise: Vec<f64> = (0..2000)
+        .map(|_| {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.2
+        })
+        .collect();
+    let stairs: Vec<f64> = noise
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v + ((i / 50) % 3) as f64)
+        .collect();
+    let beta = 3.0 * 0.06f64.powi(2) * 2000f64.ln();
+    for (name, pv) in [("noise_2000", &noise), ("stairs_2000", &stairs)] {
+        g.bench_function(name, |b| b.iter(|| levels(black_box(pv), beta, 2000)));
+    }
+    g.finish();
 }
 
 criterion_group!(diagnose_benches, benches);

@@ -101,6 +101,26 @@ pub struct Steps {
 /// PV's levels: the optimal partition under a penalty `beta` per level (PELT with pruning; a
 /// candidate level start further back than `max_level` samples is dropped).
 pub fn levels(pv: &[f64], beta: f64, max_level: usize) -> Vec<Level> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            return unsafe { levels_avx2(pv, beta, max_level) };
+        }
+    }
+    levels_in(pv, beta, max_level)
+}
+
+/// [`levels`] compiled for AVX2: the candidates' costs (a division each) four at a time where
+/// SSE2 does two; the same operations in the same order, so the same levels bit for bit.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn levels_avx2(pv: &[f64], beta: f64, max_level: usize) -> Vec<Level> {
+    levels_in(pv, beta, max_level)
+}
+
+#[inline(always)]
+fn levels_in(pv: &[f64], beta: f64, max_level: usize) -> Vec<Level> {
     let n = pv.len();
     if n == 0 {
         return Vec::new();
@@ -120,12 +140,7 @@ pub fn levels(pv: &[f64], beta: f64, max_level: usize) -> Vec<Level> {
     let mut to_t: Vec<f64> = Vec::new();
     for t in 1..=n {
         candidates.costs_to(t, (sum[t], sum2[t]), &mut to_t);
-        let (mut f, mut arg) = (f64::INFINITY, 0);
-        for (i, &v) in to_t.iter().enumerate() {
-            if v + beta < f {
-                (f, arg) = (v + beta, i);
-            }
-        }
+        let (f, arg) = first_minimum(&to_t, beta);
         best[t] = f;
         last[t] = candidates.at(arg);
         candidates.prune(&to_t, f, t, max_level, arg);
@@ -144,6 +159,27 @@ pub fn levels(pv: &[f64], beta: f64, max_level: usize) -> Vec<Level> {
     out
 }
 
+/// The smallest `v + beta` of `costs` and the first candidate that has it (as a scan for the
+/// first strict minimum finds them): the minimum over four running minima the compiler
+/// vectorises, then the first candidate equal to it.
+#[inline(always)]
+fn first_minimum(costs: &[f64], beta: f64) -> (f64, usize) {
+    let mut lanes = [f64::INFINITY; 4];
+    let chunks = costs.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for k in 0..4 {
+            lanes[k] = lanes[k].min(c[k] + beta);
+        }
+    }
+    let f = rest.iter().fold(
+        lanes[0].min(lanes[1]).min(lanes[2].min(lanes[3])),
+        |m, &v| m.min(v + beta),
+    );
+    let arg = costs.iter().position(|&v| v + beta == f).unwrap_or(0);
+    (f, arg)
+}
+
 /// PELT's candidate level starts, side by side (so the cost of each to a sample is one pass the
 /// compiler vectorises): where each starts, the best cost up to it, and the sums up to it. The
 /// candidates are those from `head` on (those too far back leave from the front, without moving
@@ -159,6 +195,7 @@ struct Candidates {
 }
 
 impl Candidates {
+    #[inline(always)]
     fn push(&mut self, at: usize, best: f64, sum: f64, sum2: f64) {
         self.at.push(at);
         self.start.push(at as f64);
@@ -168,12 +205,14 @@ impl Candidates {
     }
 
     /// Where candidate `i` (counted from the head) starts.
+    #[inline(always)]
     fn at(&self, i: usize) -> usize {
         self.at[self.head + i]
     }
 
     /// Each candidate's best cost plus its level's cost to `t` (the sums up to `t`): the sum of
     /// squares about the level's mean.
+    #[inline(always)]
     fn costs_to(&self, t: usize, (sum_t, sum2_t): (f64, f64), out: &mut Vec<f64>) {
         let tf = t as f64;
         let h = self.head;
@@ -193,6 +232,7 @@ impl Candidates {
 
     /// Keep the candidates that can still start the best level (cost to `t` at most `f`,
     /// started fewer than `max_level` samples before), or the best one (`arg`) if none can.
+    #[inline(always)]
     fn prune(&mut self, to_t: &[f64], f: f64, t: usize, max_level: usize, arg: usize) {
         let (h, len) = (self.head, self.at.len());
         // those too far back are the oldest: a run from the head
@@ -200,8 +240,11 @@ impl Candidates {
         while first < len && t - self.at[first] >= max_level {
             first += 1;
         }
-        let mut kept = first;
-        for i in first..len {
+        // (on a long level most candidates stay: whether any goes is one pass the compiler
+        // vectorises, and the moves are made only where one does)
+        let goes = to_t[first - h..].iter().fold(false, |g, &v| g | (v > f));
+        let mut kept = if goes { first } else { len };
+        for i in (first..len).filter(|_| goes) {
             if to_t[i - h] <= f {
                 // (most are kept: they move only after the first one dropped)
                 if i != kept {
@@ -231,7 +274,7 @@ impl Candidates {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn move_to(&mut self, from: usize, to: usize) {
         self.at[to] = self.at[from];
         self.start[to] = self.start[from];
@@ -407,6 +450,23 @@ mod tests {
     }
 
     proptest! {
+        /// The vectorised build (AVX2 where the CPU has it) cuts PV where the plain one does.
+        #[test]
+        fn levels_are_the_same_in_every_build(
+            seed in 0u64..1000,
+            n in 20usize..600,
+            steps in proptest::collection::vec((0.0f64..1.0, -3.0f64..3.0), 0..8),
+            beta in 0.01f64..5.0,
+            max_level in 10usize..400,
+        ) {
+            let mut pv = noise(n, seed);
+            for (at, size) in steps {
+                let from = (at * n as f64) as usize;
+                pv[from..].iter_mut().for_each(|v| *v += size);
+            }
+            prop_assert_eq!(levels(&pv, beta, max_level), levels_in(&pv, beta, max_level));
+        }
+
         #[test]
         fn levels_are_the_optimal_partition(
             seed in 0u64..1000,
