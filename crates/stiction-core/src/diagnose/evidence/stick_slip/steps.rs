@@ -459,11 +459,7 @@ mod tests {
             beta in 0.01f64..5.0,
             max_level in 10usize..400,
         ) {
-            let mut pv = noise(n, seed);
-            for (at, size) in steps {
-                let from = (at * n as f64) as usize;
-                pv[from..].iter_mut().for_each(|v| *v += size);
-            }
+            let pv = stepped(n, seed, &steps);
             prop_assert_eq!(levels(&pv, beta, max_level), levels_in(&pv, beta, max_level));
         }
 
@@ -475,11 +471,7 @@ mod tests {
             beta in 0.05f64..5.0,
             max_level in 10usize..200,
         ) {
-            let mut pv = noise(n, seed);
-            for (at, size) in steps {
-                let from = (at * n as f64) as usize;
-                pv[from..].iter_mut().for_each(|v| *v += size);
-            }
+            let pv = stepped(n, seed, &steps);
             let l = levels(&pv, beta, max_level);
             prop_assert_eq!(l.first().map(|l| l.start), Some(0));
             prop_assert_eq!(l.last().map(|l| l.end), Some(n));
@@ -491,6 +483,16 @@ mod tests {
                 prop_assert!((got - want).abs() <= 1e-6 * (1.0 + want.abs()), "{} vs {}", got, want);
             }
         }
+    }
+
+    /// Noise with steps of PV: each `(at, size)` a step of `size` at that share of the record.
+    fn stepped(n: usize, seed: u64, steps: &[(f64, f64)]) -> Vec<f64> {
+        let mut pv = noise(n, seed);
+        for &(at, size) in steps {
+            let from = (at * n as f64) as usize;
+            pv[from..].iter_mut().for_each(|v| *v += size);
+        }
+        pv
     }
 
     fn noise(n: usize, seed: u64) -> Vec<f64> {
