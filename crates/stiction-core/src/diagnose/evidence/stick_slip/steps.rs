@@ -243,14 +243,17 @@ impl Candidates {
         // (on a long level most candidates stay: whether any goes is one pass the compiler
         // vectorises, and the moves are made only where one does)
         let goes = to_t[first - h..].iter().fold(false, |g, &v| g | (v > f));
-        let mut kept = if goes { first } else { len };
-        for i in (first..len).filter(|_| goes) {
-            if to_t[i - h] <= f {
-                // (most are kept: they move only after the first one dropped)
-                if i != kept {
-                    self.move_to(i, kept);
+        let mut kept = len;
+        if goes {
+            kept = first;
+            for i in first..len {
+                if to_t[i - h] <= f {
+                    // (most are kept: they move only after the first one dropped)
+                    if i != kept {
+                        self.move_to(i, kept);
+                    }
+                    kept += 1;
                 }
-                kept += 1;
             }
         }
         if kept == first {
